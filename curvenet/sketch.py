@@ -1,0 +1,120 @@
+"""The sketch: a list of 3D strokes with per-stroke labels.
+
+A stroke is an ``(n, 3) float64`` array with ``n >= 2`` finite points. Labels are
+``"boundary"`` (default: a curve the surface passes through), ``"crease"`` (a
+curve the surface passes through with a sharp edge) and ``"construction"``
+(ignored by surfacing).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .errors import InvalidParameterError
+
+__all__ = ["LABELS", "Sketch", "as_stroke"]
+
+LABELS = ("boundary", "crease", "construction")
+
+
+def as_stroke(points, *, name: str = "stroke") -> np.ndarray:
+    """Validate and convert one stroke.
+
+    Parameters
+    ----------
+    points : array_like, (n, 3)
+        Stroke points, ``n >= 2``, all finite.
+    name : str
+        Used in error messages.
+
+    Returns
+    -------
+    (n, 3) float64 ndarray
+        A C-contiguous copy.
+
+    Raises
+    ------
+    InvalidParameterError
+        Wrong shape, fewer than two points, or a NaN/inf coordinate.
+    """
+    arr = np.array(points, dtype=np.float64, copy=True)
+    if arr.ndim != 2 or arr.shape[1] != 3:
+        raise InvalidParameterError(f"{name}: expected an (n, 3) array, got shape {arr.shape}")
+    if arr.shape[0] < 2:
+        raise InvalidParameterError(f"{name}: a stroke needs at least 2 points, got {arr.shape[0]}")
+    if not np.isfinite(arr).all():
+        raise InvalidParameterError(f"{name}: contains NaN or infinite coordinates")
+    return np.ascontiguousarray(arr)
+
+
+@dataclass
+class Sketch:
+    """Strokes plus labels.
+
+    Attributes
+    ----------
+    strokes : list of (n_i, 3) float64 ndarray
+    labels : list of str
+        One of :data:`LABELS` per stroke.
+    metadata : dict
+        Free-form (units, author, source file ...); kept by the JSON format.
+    source : str or None
+        The file it was read from, if any.
+
+    Examples
+    --------
+    >>> s = Sketch([[[0, 0, 0], [1, 0, 0]], [[0, 0, 0], [0, 1, 0]]])
+    >>> len(s), s.labels
+    (2, ['boundary', 'boundary'])
+    >>> round(s.diagonal, 6)
+    1.414214
+    """
+
+    strokes: list
+    labels: list | None = None
+    metadata: dict = field(default_factory=dict)
+    source: str | None = None
+
+    def __post_init__(self):
+        self.strokes = [as_stroke(s, name=f"stroke {i}") for i, s in enumerate(self.strokes)]
+        if self.labels is None:
+            self.labels = ["boundary"] * len(self.strokes)
+        self.labels = [str(lab) for lab in self.labels]
+        if len(self.labels) != len(self.strokes):
+            raise InvalidParameterError(
+                f"labels: {len(self.labels)} labels for {len(self.strokes)} strokes")
+        for i, lab in enumerate(self.labels):
+            if lab not in LABELS:
+                raise InvalidParameterError(f"labels[{i}]: unknown label {lab!r}; use one of {LABELS}")
+
+    def __len__(self) -> int:
+        return len(self.strokes)
+
+    @property
+    def points(self) -> np.ndarray:
+        """All stroke points stacked, ``(N, 3) float64``."""
+        if not self.strokes:
+            return np.zeros((0, 3))
+        return np.concatenate(self.strokes, axis=0)
+
+    @property
+    def bounds(self) -> np.ndarray:
+        """Axis-aligned bounding box ``(2, 3)``: min row, max row."""
+        pts = self.points
+        if len(pts) == 0:
+            return np.zeros((2, 3))
+        return np.stack([pts.min(axis=0), pts.max(axis=0)])
+
+    @property
+    def diagonal(self) -> float:
+        """Length of the bounding-box diagonal (the unit of every relative tolerance)."""
+        b = self.bounds
+        return float(np.linalg.norm(b[1] - b[0]))
+
+    def select(self, labels=("boundary", "crease")) -> "Sketch":
+        """The sub-sketch of strokes whose label is in ``labels``."""
+        keep = [i for i, lab in enumerate(self.labels) if lab in labels]
+        return Sketch([self.strokes[i] for i in keep], [self.labels[i] for i in keep],
+                      dict(self.metadata), self.source)
