@@ -87,7 +87,8 @@ class Sketch:
                 f"labels: {len(self.labels)} labels for {len(self.strokes)} strokes")
         for i, lab in enumerate(self.labels):
             if lab not in LABELS:
-                raise InvalidParameterError(f"labels[{i}]: unknown label {lab!r}; use one of {LABELS}")
+                raise InvalidParameterError(
+                    f"labels[{i}]: unknown label {lab!r}; use one of {LABELS}")
 
     def __len__(self) -> int:
         return len(self.strokes)

@@ -1,0 +1,52 @@
+"""The analytic oracles must themselves be right: counts, Euler characteristic, orientation,
+curves on the true surface."""
+
+import numpy as np
+import pytest
+import trimesh
+
+from curvenet import shapes
+
+
+@pytest.mark.parametrize("name", sorted(shapes.SHAPES))
+def test_shape_is_consistent(name):
+    s = shapes.SHAPES[name]()
+    net = s.network
+    # every loop is closed: the head of each edge is the tail of the next
+    for loop in s.faces:
+        ends = [(net.edges[e].u, net.edges[e].v)[:: 1 if f else -1] for e, f in loop]
+        assert all(b == c for (_, b), (c, _) in zip(ends, ends[1:] + ends[:1]))
+    # manifold edges are walked in opposite directions by their two faces
+    use = {}
+    for loop in s.faces:
+        for e, f in loop:
+            use.setdefault(e, []).append(f)
+    assert all(v[0] != v[1] for v in use.values() if len(v) == 2)
+    # Euler characteristic of the patch complex: 2 - 2g closed, 1 for a disk
+    chi = net.number_of_vertices - net.number_of_edges + len(s.faces)
+    if name == "two_boxes":
+        assert chi == 3  # two spheres glued along a disk
+    elif s.closed:
+        assert chi == 2 - 2 * s.genus
+    else:
+        assert chi == 1
+    if s.closed and name != "two_boxes":
+        assert shapes._signed_volume(net, s.faces) > 0
+    # curve samples lie on the reference surface (chord error of the reference only)
+    ref = s.reference_mesh(5)
+    pts = np.concatenate([e.curve for e in net.edges])
+    _, dist, _ = trimesh.proximity.closest_point(ref, pts[::5])
+    assert dist.max() < 1e-3 * np.linalg.norm(ref.extents)
+
+
+def test_grid_box_counts():
+    s = shapes.grid_box(4)
+    assert (s.network.number_of_edges, len(s.faces)) == (192, 96)
+    assert sum(e.label == "crease" for e in s.network.edges) == 48
+    assert shapes.grid_box(9).network.number_of_edges == 972
+
+
+def test_sketch_has_one_stroke_per_edge():
+    s = shapes.box()
+    sk = s.sketch()
+    assert len(sk) == 12 and set(sk.labels) == {"crease"}
