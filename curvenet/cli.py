@@ -1,0 +1,265 @@
+"""The ``curvenet`` command: a thin layer over the library.
+
+Parses arguments, calls :mod:`curvenet.pipeline` and friends, and turns a
+:class:`~curvenet.errors.CurvenetError` into one line on stderr and exit code 2
+(1 for an internal failure, 130 for Ctrl-C); ``--debug`` shows tracebacks.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+from .errors import CurvenetError, InvalidParameterError
+
+__all__ = ["main", "build_parser"]
+
+
+def _fraction(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not (0.0 < value < 0.5):
+        raise argparse.ArgumentTypeError(
+            f"{text} is not a fraction of the bounding-box diagonal in (0, 0.5)")
+    return value
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text} is not a positive integer")
+    return value
+
+
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="curvenet",
+                                description="3D sketches and curve networks to surfaces.")
+    p.add_argument("--debug", action="store_true", help="show tracebacks on errors")
+    sub = p.add_subparsers(dest="command", required=True)
+
+    s = sub.add_parser("snap", help="snap rough strokes into a curve network (NETWORK.json)")
+    s.add_argument("input")
+    s.add_argument("-o", "--output", required=True, help="NETWORK.json (or .obj polylines)")
+    s.add_argument("--snap-tol", type=_fraction, help="fraction of the bbox diagonal")
+
+    s = sub.add_parser("patches", help="find surface patches (PATCHES.json)")
+    s.add_argument("input", help="sketch file or NETWORK.json")
+    s.add_argument("-o", "--output", required=True, help="PATCHES.json")
+    s.add_argument("--snap-tol", type=_fraction)
+    s.add_argument("--close", choices=("auto", "none"), default="auto",
+                   help="accept solid-closing patches automatically (default auto)")
+    s.add_argument("--interactive", action="store_true",
+                   help="review patches: delete, accept/reject suggestions, undo, save")
+    s.add_argument("--preview", metavar="PNG", help="write a picture of the patches")
+
+    s = sub.add_parser("surface", help="surface a sketch, network or patch set")
+    s.add_argument("inputs", nargs="+", metavar="INPUT")
+    s.add_argument("-o", "--output", help="mesh file (.obj .ply .stl .off .glb)")
+    s.add_argument("--out-dir", help="batch mode: write INPUT-stem.<--format> here")
+    s.add_argument("--format", default="obj", choices=("obj", "ply", "stl", "off", "glb"),
+                   help="mesh format in batch mode (default obj)")
+    s.add_argument("--jobs", type=_positive_int, default=1, help="batch: parallel processes")
+    s.add_argument("--method", choices=("auto", "classical", "neural"), default="auto")
+    s.add_argument("--patches", metavar="PATCHES.json", help="use this (edited) patch set")
+    s.add_argument("--snap-tol", type=_fraction)
+    s.add_argument("--close", choices=("auto", "none"), default="auto")
+    s.add_argument("--surfacer", choices=("catmull-clark", "soapfilm"), default="catmull-clark")
+    s.add_argument("--subdiv", type=_positive_int, help="Catmull-Clark levels")
+    s.add_argument("--resolution", type=_positive_int, help="Coons samples per side segment")
+    s.add_argument("--crease-angle", type=float, default=30.0, metavar="DEG")
+    s.add_argument("--refine", action="store_true",
+                   help="continue the classical result with the neural flow-alignment fit")
+    s.add_argument("--quality", choices=("draft", "default", "paper"), default="draft")
+    s.add_argument("--device", default="cpu", help="cpu or cuda (neural route)")
+    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--preview", metavar="PNG", help="write a picture of the result")
+    s.add_argument("--explain", action="store_true", help="say which route was taken and why")
+    s.add_argument("--no-progress", action="store_true", help="hide progress bars")
+
+    s = sub.add_parser("eval", help="compare a mesh with a reference mesh or the sketch")
+    s.add_argument("mesh")
+    s.add_argument("reference", help="reference mesh, or a sketch file for stroke distance")
+    s.add_argument("--json", action="store_true", help="print JSON")
+    s.add_argument("--samples", type=_positive_int, default=100_000)
+    s.add_argument("--threshold", type=float, default=0.01, help="F-score threshold")
+    return p
+
+
+# --------------------------------------------------------------------------- commands
+def _cmd_snap(args) -> int:
+    from .io import read_sketch, write_network_obj
+    from .patchset import save_network
+    from .snap import snap
+    sketch = read_sketch(args.input)
+    net = snap(sketch, **({} if args.snap_tol is None else {"snap_tol": args.snap_tol}))
+    if args.output.lower().endswith(".obj"):
+        write_network_obj(args.output, net)
+    else:
+        save_network(args.output, net)
+    rep = ", ".join(f"{k} {v}" for k, v in net.report.items() if isinstance(v, (int, float)))
+    print(f"{args.output}: {net.number_of_vertices} vertices, {net.number_of_edges} curves"
+          + (f" ({rep})" if rep else ""))
+    return 0
+
+
+def _cmd_patches(args) -> int:
+    from .patchset import save_patchset
+    from .pipeline import patches
+    ps = patches(args.input, snap_tol=args.snap_tol, close=args.close)
+    if args.interactive:
+        from .session import run_interactive
+        ps = run_interactive(ps, input=sys.stdin, output=sys.stdout, preview=args.preview)
+    save_patchset(args.output, ps)
+    t = ps.report.get("timings", {})
+    print(f"{args.output}: {len(ps.patches)} patches on {ps.network.number_of_edges} curves "
+          f"({sum(t.values()):.2f} s)")
+    if args.preview:
+        from .preview import render_preview
+        render_preview(args.preview, network=ps.network, patches=ps, title=Path(args.input).name)
+    return 0
+
+
+def _surface_one(inp: str, out: str, args) -> dict:
+    """Surface one input; returns a status row (never raises CurvenetError)."""
+    from .patchset import load_network_file
+    from .pipeline import surface
+    t0 = time.perf_counter()
+    try:
+        ps = load_network_file(args.patches) if args.patches else None
+        res = surface(inp, method=args.method, patchset=ps, snap_tol=args.snap_tol,
+                      close=args.close, surfacer=args.surfacer, subdiv=args.subdiv,
+                      resolution=args.resolution, crease_angle=args.crease_angle,
+                      refine=args.refine, quality=args.quality, device=args.device,
+                      seed=args.seed, progress=not args.no_progress)
+        res.save(out)
+        if args.preview:
+            from .preview import render_preview
+            prev = args.preview if args.output else str(Path(out).with_suffix(".png"))
+            render_preview(prev, strokes=res.sketch.strokes if res.sketch else None,
+                           network=res.network, mesh=res.mesh, title=f"{Path(inp).name}: "
+                           f"{res.method}")
+        return {"input": inp, "output": out, "status": "ok", "method": res.method,
+                "faces": len(res.mesh.faces), "seconds": time.perf_counter() - t0,
+                "why": res.diagnostics.get("decision", "")}
+    except CurvenetError as err:
+        return {"input": inp, "output": out, "status": "error", "error": str(err),
+                "seconds": time.perf_counter() - t0}
+
+
+def _cmd_surface(args) -> int:
+    from .pipeline import MESH_FORMATS
+    if args.out_dir is None:
+        if args.output is None:
+            raise InvalidParameterError("surface: give -o MESH (one input) or --out-dir DIR")
+        if len(args.inputs) > 1:
+            raise InvalidParameterError("surface: several inputs need --out-dir DIR, not -o")
+        if Path(args.output).suffix.lower() not in MESH_FORMATS:
+            raise InvalidParameterError(f"output {args.output}: unknown mesh format; use one "
+                                        f"of {', '.join(MESH_FORMATS)}")
+        jobs = [(args.inputs[0], args.output)]
+    else:
+        out_dir = Path(args.out_dir)
+        out_dir.mkdir(parents=True, exist_ok=True)
+        jobs = [(i, str(out_dir / f"{Path(i).stem}.{args.format}")) for i in args.inputs]
+    if len(jobs) == 1:
+        row = _surface_one(*jobs[0], args)
+        if row["status"] != "ok":
+            raise CurvenetError(row["error"])
+        print(f"{row['output']}: {row['faces']} faces, {row['method']}, {row['seconds']:.1f} s")
+        if args.explain:
+            print(f"route: {row['why']}")
+        return 0
+    args.no_progress = True
+    if args.jobs > 1:
+        from concurrent.futures import ProcessPoolExecutor
+        with ProcessPoolExecutor(max_workers=args.jobs) as pool:
+            futures = [pool.submit(_surface_one, i, o, args) for i, o in jobs]
+            rows = []
+            for f in futures:
+                rows.append(f.result())
+                _print_row(rows[-1], args.explain)
+    else:
+        rows = []
+        for i, o in jobs:
+            rows.append(_surface_one(i, o, args))
+            _print_row(rows[-1], args.explain)
+    ok = sum(r["status"] == "ok" for r in rows)
+    print(f"{ok} of {len(rows)} surfaced, {len(rows) - ok} failed, "
+          f"{sum(r['seconds'] for r in rows):.1f} s in all")
+    return 0 if ok == len(rows) else 2
+
+
+def _print_row(row: dict, explain: bool) -> None:
+    if row["status"] == "ok":
+        line = f"ok     {row['input']} -> {row['output']}  {row['method']:<10s} " \
+               f"{row['faces']:>8d} faces {row['seconds']:7.1f} s"
+        if explain:
+            line += f"  ({row['why']})"
+    else:
+        line = f"FAILED {row['input']}: {row['error']}"
+    print(line, flush=True)
+
+
+def _cmd_eval(args) -> int:
+    from .evaluate import evaluate_mesh, format_report, load_mesh, stroke_distance
+    from .pipeline import MESH_FORMATS
+    ref = Path(args.reference)
+    if ref.suffix.lower() in MESH_FORMATS and ref.suffix.lower() != ".obj" or _is_mesh_obj(ref):
+        metrics = evaluate_mesh(args.mesh, args.reference, n_samples=args.samples,
+                                threshold=args.threshold)
+    else:
+        from .io import read_sketch
+        sketch = read_sketch(ref)
+        metrics = stroke_distance(load_mesh(args.mesh), sketch.select(("boundary",
+                                                                       "crease")).strokes)
+    print(json.dumps(metrics, indent=2) if args.json else format_report(metrics))
+    return 0
+
+
+def _is_mesh_obj(path: Path) -> bool:
+    """An OBJ with ``f`` lines is a mesh; one with only ``l`` lines is a sketch."""
+    if path.suffix.lower() != ".obj" or not path.is_file():
+        return False
+    with open(path, "rb") as fh:
+        for raw in fh:
+            if raw.startswith(b"f "):
+                return True
+    return False
+
+
+COMMANDS = {"snap": _cmd_snap, "patches": _cmd_patches, "surface": _cmd_surface,
+            "eval": _cmd_eval}
+
+
+def main(argv=None) -> int:
+    """Entry point of the ``curvenet`` command; returns the exit code."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return COMMANDS[args.command](args)
+    except CurvenetError as err:
+        if args.debug:
+            raise
+        print(f"curvenet {args.command}: error: {err}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"curvenet {args.command}: interrupted", file=sys.stderr)
+        return 130
+    except Exception as err:  # an internal failure: one line unless --debug
+        if args.debug:
+            raise
+        print(f"curvenet {args.command}: internal error: {type(err).__name__}: {err} "
+              f"(run with --debug for the traceback)", file=sys.stderr)
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,352 @@
+"""One pipeline from a sketch file to a surface: snap, find patches, surface.
+
+``surface(...)`` decides by itself (``method="auto"``) whether the classical
+patch route (Coons -> Catmull-Clark limit fit, :mod:`surfacing`) or the neural
+route (flow-aligned implicit, :mod:`neural`) serves the sketch better, and says
+why in ``SurfaceResult.diagnostics["decision"]``.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ._atomic import atomic_path
+from .errors import CurvenetError, InvalidParameterError, SketchFormatError
+from .network import CurveNetwork
+from .patchset import PatchSet, load_network_file
+from .sketch import Sketch
+
+__all__ = ["SurfaceResult", "surface", "patches", "load_source", "MESH_FORMATS",
+           "AUTO_MIN_COVERAGE", "write_mesh"]
+
+MESH_FORMATS = (".obj", ".ply", ".stl", ".off", ".glb")
+METHODS = ("auto", "classical", "neural")
+QUALITIES = ("draft", "default", "paper")
+
+#: auto mode takes the classical route when at least this fraction of the
+#: network's curve length lies on curves used by some patch.
+AUTO_MIN_COVERAGE = 0.8
+
+
+@dataclass
+class SurfaceResult:
+    """What :func:`surface` produced.
+
+    Attributes
+    ----------
+    mesh : trimesh.Trimesh
+        The surface, in the sketch's coordinates.
+    method : str
+        ``"classical"``, ``"soapfilm"`` or ``"neural"`` (plus ``"+refine"`` /
+        ``"+creases"`` suffixes when those stages ran).
+    sketch : Sketch or None
+    network : CurveNetwork or None
+    patchset : PatchSet or None
+    timings : dict
+        Seconds per stage (``snap``, ``patches``, ``classical``, ``neural`` ...).
+    diagnostics : dict
+        ``decision`` (why this route), ``coverage``, ``unused_edges`` (curves no
+        patch uses: dangling details, reported not lost), backend reports.
+    """
+
+    mesh: object
+    method: str
+    sketch: Sketch | None = None
+    network: CurveNetwork | None = None
+    patchset: PatchSet | None = None
+    timings: dict = field(default_factory=dict)
+    diagnostics: dict = field(default_factory=dict)
+
+    def save(self, path) -> Path:
+        """Write the mesh atomically; the format follows the extension."""
+        return write_mesh(path, self.mesh)
+
+
+def write_mesh(path, mesh) -> Path:
+    """Write a ``trimesh.Trimesh`` to ``path`` (OBJ / PLY / STL / OFF / GLB) atomically."""
+    path = Path(path)
+    if path.suffix.lower() not in MESH_FORMATS:
+        raise InvalidParameterError(
+            f"output {path}: unknown mesh format {path.suffix!r}; use one of {MESH_FORMATS}")
+    with atomic_path(path) as tmp:
+        mesh.export(tmp, file_type=path.suffix.lower()[1:])
+    return path
+
+
+def _is_network_json(path: Path) -> bool:
+    if path.suffix.lower() != ".json":
+        return False
+    with open(path, "rb") as fh:
+        head = fh.read(4096)
+    return b'"curvenet.network"' in head or b'"curvenet.patches"' in head
+
+
+def load_source(source):
+    """Turn what the user gave into ``(sketch, patchset)``; one of them may be None.
+
+    Parameters
+    ----------
+    source : Sketch, CurveNetwork, PatchSet, str or os.PathLike
+        A sketch, or a file: any sketch format, ``NETWORK.json`` or ``PATCHES.json``.
+    """
+    if isinstance(source, Sketch):
+        return source, None
+    if isinstance(source, PatchSet):
+        return None, source
+    if isinstance(source, CurveNetwork):
+        return None, PatchSet(source)
+    path = Path(source)
+    if not path.is_file():
+        raise SketchFormatError("no such file", path=path)
+    if _is_network_json(path):
+        return None, load_network_file(path)
+    from .io import read_sketch
+    return read_sketch(path), None
+
+
+def _network(sketch, patchset, *, snap_tol, timings):
+    if patchset is not None:
+        return patchset.network
+    from .snap import snap
+    t = time.perf_counter()
+    kwargs = {} if snap_tol is None else {"snap_tol": snap_tol}
+    net = snap(sketch, **kwargs)
+    timings["snap"] = time.perf_counter() - t
+    return net
+
+
+def patches(source, *, snap_tol: float | None = None, close: str = "auto",
+            **options) -> PatchSet:
+    """Snap (when given a sketch) and find patches.
+
+    Parameters
+    ----------
+    source : Sketch, CurveNetwork, str or os.PathLike
+        A sketch or a ``NETWORK.json`` / ``PATCHES.json`` file (its patches are
+        recomputed).
+    snap_tol : float, optional
+        Snapping tolerance as a fraction of the bounding-box diagonal.
+    close : {"auto", "none"}
+        Accept closing patches automatically (see :func:`curvenet.cycles.find_patches`).
+    **options
+        Passed to :func:`curvenet.cycles.find_patches`.
+
+    Returns
+    -------
+    PatchSet
+        ``report["timings"]`` has the snapping and patch-finding seconds.
+
+    Examples
+    --------
+    >>> from curvenet import shapes
+    >>> ps = patches(shapes.box().sketch())
+    >>> len(ps.patches)
+    6
+    """
+    from .cycles import find_patches
+    sketch, given = load_source(source)
+    timings: dict = {}
+    net = _network(sketch, given, snap_tol=snap_tol, timings=timings)
+    t = time.perf_counter()
+    ps = find_patches(net, close=close, **options)
+    timings["patches"] = time.perf_counter() - t
+    ps.report.setdefault("timings", {}).update(timings)
+    return ps
+
+
+def _coverage(ps: PatchSet) -> tuple[float, list]:
+    """Fraction of curve length on edges used by a patch, and the unused edge ids."""
+    net = ps.network
+    if not net.edges:
+        return 0.0, []
+    lengths = np.array([e.length() for e in net.edges])
+    used = np.zeros(len(lengths), bool)
+    for p in ps.patches:
+        used[list(p.edges)] = True
+    total = lengths.sum()
+    cov = float(lengths[used].sum() / total) if total > 0 else 0.0
+    return cov, [int(i) for i in np.flatnonzero(~used)]
+
+
+def _mesh(vertices, faces):
+    import trimesh
+    return trimesh.Trimesh(np.asarray(vertices, np.float64), np.asarray(faces, np.int64),
+                           process=False)
+
+
+def _classical(ps: PatchSet, *, surfacer, subdiv, resolution, crease_angle, options):
+    import surfacing
+
+    from .cycles import orient_patches
+    net = ps.network
+    loops = orient_patches(net, ps.patches)
+    curves = [e.curve for e in net.edges]
+    creases = [i for i, e in enumerate(net.edges) if e.label == "crease"]
+    kw = dict(options)
+    if surfacer == "soapfilm":
+        res = surfacing.soapfilm_loops(curves, loops, **kw)
+    else:
+        if subdiv is not None:
+            kw["subdiv"] = subdiv
+        if resolution is not None:
+            kw["resolution"] = resolution
+        res = surfacing.surface_loops(curves, loops, crease_curves=creases,
+                                      crease_angle=crease_angle, **kw)
+    return _mesh(res.vertices, res.faces), dict(res.report)
+
+
+def _strokes_for_neural(sketch: Sketch | None, net: CurveNetwork | None):
+    if sketch is not None:
+        sub = sketch.select(("boundary", "crease"))
+        return sub.strokes, sub.labels
+    return [e.curve for e in net.edges], [e.label for e in net.edges]
+
+
+def _neural(strokes, labels, *, quality, device, seed, progress, init_mesh, options):
+    from neural.flow import fit_flow_surface
+    res = fit_flow_surface(strokes, labels=labels, quality=quality, device=device, seed=seed,
+                           init_mesh=init_mesh, progress=progress, **options)
+    verts, faces, report = res.vertices, res.faces, dict(res.report)
+    if "crease" in labels and not report.get("interrupted"):
+        from neural.creases import crease_refine
+        cres = crease_refine(verts, faces, strokes, labels, quality=quality, device=device,
+                             seed=seed, progress=progress)
+        verts, faces = cres.vertices, cres.faces
+        report["creases"] = dict(cres.report)
+    return _mesh(verts, faces), report
+
+
+def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
+            snap_tol: float | None = None, close: str = "auto", surfacer: str = "catmull-clark",
+            subdiv: int | None = None, resolution: int | None = None,
+            crease_angle: float = 30.0, refine: bool = False, quality: str = "draft",
+            device: str = "cpu", seed: int = 0, progress: bool = False,
+            classical_options: dict | None = None,
+            neural_options: dict | None = None) -> SurfaceResult:
+    """Sketch (or network, or patch set) to surface.
+
+    Parameters
+    ----------
+    source : Sketch, CurveNetwork, PatchSet, str or os.PathLike
+        The input: a sketch, a sketch file in any supported format, or a
+        ``NETWORK.json`` / ``PATCHES.json`` file.
+    method : {"auto", "classical", "neural"}
+        ``auto`` snaps, finds patches and takes the classical route when the
+        patches cover at least :data:`AUTO_MIN_COVERAGE` of the curve length,
+        else the neural route.
+    patchset : PatchSet, optional
+        Use these patches (e.g. an edited ``PATCHES.json``) instead of finding them.
+    snap_tol : float, optional
+        Snapping tolerance (fraction of the bounding-box diagonal).
+    close : {"auto", "none"}
+        Closing-patch policy of the patch finder.
+    surfacer : {"catmull-clark", "soapfilm"}
+        Classical surfacer: Orbay-Kara limit fitting or the soap-film baseline.
+    subdiv, resolution : int, optional
+        Classical settings (Catmull-Clark levels, samples per side); backend defaults.
+    crease_angle : float
+        Dihedral angle (degrees) above which a curve becomes a crease.
+    refine : bool
+        Continue the classical result with the neural flow-alignment fit.
+    quality : {"draft", "default", "paper"}
+        Neural preset.
+    device : str
+        ``"cpu"`` or ``"cuda"`` for the neural route.
+    seed : int
+        Seed of every random choice.
+    progress : bool
+        Show progress bars.
+    classical_options, neural_options : dict, optional
+        Extra keyword arguments for :func:`surfacing.surface_loops` /
+        :func:`neural.flow.fit_flow_surface`.
+
+    Returns
+    -------
+    SurfaceResult
+
+    Examples
+    --------
+    >>> from curvenet import shapes
+    >>> res = surface(shapes.box().sketch(), method="classical")
+    >>> res.method, res.mesh.is_watertight
+    ('classical', True)
+    """
+    if method not in METHODS:
+        raise InvalidParameterError(f"method: {method!r} is not one of {METHODS}")
+    if quality not in QUALITIES:
+        raise InvalidParameterError(f"quality: {quality!r} is not one of {QUALITIES}")
+    if surfacer not in ("catmull-clark", "soapfilm"):
+        raise InvalidParameterError(f"surfacer: {surfacer!r} is not catmull-clark or soapfilm")
+    if not (0.0 < crease_angle < 180.0):
+        raise InvalidParameterError(f"crease_angle: {crease_angle!r} is not in (0, 180)")
+    if device not in ("cpu", "cuda") and not str(device).startswith("cuda:"):
+        raise InvalidParameterError(f"device: {device!r} is not cpu or cuda")
+    timings: dict = {}
+    diag: dict = {}
+    sketch, given = load_source(source)
+    if patchset is not None:
+        given = patchset
+    if sketch is not None and len(sketch.select(("boundary", "crease"))) == 0:
+        raise InvalidParameterError(f"{sketch.source or 'sketch'}: no boundary or crease strokes")
+
+    ps = None
+    net = given.network if given is not None else None
+    if method in ("auto", "classical"):
+        from .cycles import find_patches
+        net = _network(sketch, given, snap_tol=snap_tol, timings=timings)
+        diag["snap"] = dict(net.report)
+        if given is not None and given.patches:
+            ps = given
+        else:
+            t = time.perf_counter()
+            ps = find_patches(net, close=close)
+            timings["patches"] = time.perf_counter() - t
+        cov, unused = _coverage(ps)
+        diag.update(coverage=cov, unused_edges=unused, patches=len(ps.patches))
+        if method == "auto":
+            if not ps.patches:
+                reason = "neural: the strokes form no cycles that can be patches"
+            elif cov < AUTO_MIN_COVERAGE:
+                reason = (f"neural: patches cover only {cov:.0%} of the curve length "
+                          f"(< {AUTO_MIN_COVERAGE:.0%})")
+            else:
+                reason = (f"classical: {len(ps.patches)} patches cover {cov:.0%} of the curve "
+                          f"length (>= {AUTO_MIN_COVERAGE:.0%})")
+            diag["decision"] = reason
+            method = reason.split(":")[0]
+        else:
+            diag["decision"] = "classical: requested"
+        if method == "classical" and not ps.patches:
+            raise CurvenetError("no patches found: the curves form no cycles; "
+                                "try --method neural")
+    else:
+        diag["decision"] = "neural: requested"
+
+    mesh = None
+    name = method
+    try:
+        if method == "classical":
+            t = time.perf_counter()
+            mesh, rep = _classical(ps, surfacer=surfacer, subdiv=subdiv, resolution=resolution,
+                                   crease_angle=crease_angle, options=classical_options or {})
+            timings["classical"] = time.perf_counter() - t
+            diag["classical"] = rep
+            name = "soapfilm" if surfacer == "soapfilm" else "classical"
+        if method == "neural" or refine:
+            strokes, labels = _strokes_for_neural(sketch, net)
+            init = (np.asarray(mesh.vertices), np.asarray(mesh.faces)) if mesh is not None else None
+            t = time.perf_counter()
+            mesh, rep = _neural(strokes, labels, quality=quality, device=device, seed=seed,
+                                progress=progress, init_mesh=init, options=neural_options or {})
+            timings["neural"] = time.perf_counter() - t
+            diag["neural"] = rep
+            name = name + "+refine" if init is not None else "neural"
+    except ValueError as err:
+        raise InvalidParameterError(str(err)) from err
+    if mesh is None or len(mesh.faces) == 0:
+        raise CurvenetError(f"the {name} route produced an empty surface")
+    return SurfaceResult(mesh, name, sketch, net, ps, timings, diag)
