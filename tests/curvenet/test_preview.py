@@ -1,0 +1,160 @@
+"""Tests of curvenet.preview: pictures are written, show what they should, and are headless."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import trimesh
+
+from curvenet.errors import InvalidParameterError
+from curvenet.patchset import Patch, PatchSet
+from curvenet.preview import (HIGHLIGHT_COLOUR, MAX_PREVIEW_FACES, decimate_clustering,
+                              patch_polygons, render_preview)
+from curvenet.shapes import box, house
+
+
+def read_png(path):
+    from matplotlib.image import imread
+
+    img = imread(str(path))  # (H, W, 3|4) float in [0, 1]
+    return img[..., :3]
+
+
+def non_white(img):
+    return np.any(img < 0.97, axis=-1)
+
+
+def count_colour(img, rgb, tol=0.03):
+    """Pixels within ``tol`` of ``rgb`` in every channel."""
+    return int(np.all(np.abs(img - np.asarray(rgb)) < tol, axis=-1).sum())
+
+
+def true_patchset(shape):
+    return PatchSet(shape.network, [Patch(edges=[e for e, _ in loop]) for loop in shape.faces])
+
+
+def test_sphere_mesh_picture(tmp_path):
+    out = render_preview(tmp_path / "sub" / "sphere.png",
+                         mesh=trimesh.creation.icosphere(subdivisions=3), size=(400, 300))
+    assert out == tmp_path / "sub" / "sphere.png"
+    img = read_png(out)
+    assert img.shape == (300, 400, 3)
+    mask = non_white(img)
+    # two spheres, each of radius ~0.3 of a 200 px panel: a few % of the picture at least
+    assert 0.05 < mask.mean() < 0.6
+    # Lambert shading: the grey varies across the sphere (ambient 0.3 .. full light)
+    grey = img[mask].mean(axis=1)
+    assert grey.max() - grey.min() > 0.3
+    assert sorted(p.name for p in out.parent.iterdir()) == ["sphere.png"]  # no temp file
+
+
+def test_patches_coloured_and_highlight(tmp_path):
+    ps = true_patchset(house())
+    plain = read_png(render_preview(tmp_path / "plain.png", patches=ps, view=(20, -60)))
+    # distinct patch colours: several hues among the saturated pixels
+    from matplotlib.colors import rgb_to_hsv
+
+    hsv = rgb_to_hsv(plain[non_white(plain)])
+    hues = np.round(hsv[hsv[:, 1] > 0.3, 0] * 12) % 12
+    assert len(np.unique(hues)) >= 3
+    assert count_colour(plain, HIGHLIGHT_COLOUR) == 0  # the palette never makes it
+    hl = read_png(render_preview(tmp_path / "hl.png", patches=ps, highlight=[1],
+                                 view=(20, -60)))
+    assert count_colour(hl, HIGHLIGHT_COLOUR) > 200  # 3 px wide outline, ~100 px long
+    # a suggested cycle given by edge ids (not in the set) is drawn the same way
+    loop = [e for e, _ in house().faces[2]]
+    sug = read_png(render_preview(tmp_path / "sug.png", network=ps.network,
+                                  highlight=[loop], view=(20, -60)))
+    assert count_colour(sug, HIGHLIGHT_COLOUR) > 200
+
+
+def test_list_of_patches_needs_network(tmp_path):
+    shape = box()
+    patches = true_patchset(shape).patches
+    render_preview(tmp_path / "a.png", patches=patches, network=shape.network)
+    with pytest.raises(InvalidParameterError, match="network"):
+        render_preview(tmp_path / "b.png", patches=patches)
+
+
+def test_sketch_strokes(tmp_path, data_dir):
+    from curvenet.io import read_sketch
+
+    sketch = read_sketch(data_dir / "sketches" / "vns" / "car.obj")
+    img = read_png(render_preview(tmp_path / "car.png", strokes=sketch, up="y",
+                                  title="car"))
+    dark = np.all(img < 0.6, axis=-1)  # stroke pixels (grey 0.25 at alpha 0.8)
+    assert dark.mean() > 0.003
+
+
+def test_strokes_and_mesh_together_and_views(tmp_path):
+    shape = box()
+    img = read_png(render_preview(tmp_path / "x.png", strokes=shape.sketch(),
+                                  mesh=shape.reference_mesh(2),
+                                  view=[(20, -60), (20, 30), (60, 0)], size=(600, 200)))
+    assert img.shape == (200, 600, 3)
+    for k in range(3):  # every panel has something in it
+        assert non_white(img[:, 200 * k:200 * (k + 1)]).mean() > 0.02
+
+
+def test_decimation_keeps_the_surface():
+    """Clustering 81,920 faces to <= 60,000 moves the surface by a second-order amount.
+
+    The cell is about h = sqrt(2 A / 60000) ~ 0.016 (A ~ 7.9 for this ellipsoid). Merged
+    vertices are cell means of points on the surface, so they leave it by about the
+    sagitta kappa h^2 / 2 <= 2.8 * 0.016^2 / 2 ~ 3.6e-4 (kappa <= 1 / 0.6^2 at the tips),
+    1.8e-4 after normalising by the longest side 2: Hausdorff < 5e-4 and Chamfer (a mean,
+    measured 2.3e-5) < 1e-4.
+    """
+    from curvenet.evaluate import evaluate_mesh
+
+    m = trimesh.creation.icosphere(subdivisions=6)
+    m.vertices *= [1.0, 0.8, 0.6]
+    v, f = decimate_clustering(m.vertices, m.faces, MAX_PREVIEW_FACES)
+    assert MAX_PREVIEW_FACES // 3 < len(f) <= MAX_PREVIEW_FACES
+    assert f.min() >= 0 and f.max() == len(v) - 1
+    r = evaluate_mesh((v, f), m, n_samples=20_000)
+    assert r["chamfer"] < 1e-4 and r["hausdorff"] < 5e-4
+    same_v, same_f = decimate_clustering(m.vertices, m.faces[:100], MAX_PREVIEW_FACES)
+    assert len(same_f) == 100
+
+
+def test_patch_polygons_walk_the_cycle():
+    shape = box(samples=9)
+    net = shape.network
+    loop = [e for e, _ in shape.faces[0]]
+    (poly,) = patch_polygons(net, sorted(loop, reverse=True))
+    assert poly.shape == (4 * 8, 3)  # four curves of 9 points, shared ends once
+    # a closed walk: consecutive points (and last -> first) are one curve step apart
+    steps = np.linalg.norm(np.diff(np.vstack([poly, poly[:1]]), axis=0), axis=1)
+    assert np.allclose(steps, 1.0 / 8)
+    # planar face: all points on one plane
+    centred = poly - poly.mean(axis=0)
+    assert np.linalg.svd(centred, compute_uv=False)[-1] < 1e-12
+    assert patch_polygons(net, loop[:3]) == []  # an open chain gives no polygon
+    with pytest.raises(InvalidParameterError, match="out of range"):
+        patch_polygons(net, [999])
+
+
+def test_bad_arguments(tmp_path):
+    m = trimesh.creation.box()
+    with pytest.raises(InvalidParameterError, match="nothing to draw"):
+        render_preview(tmp_path / "a.png")
+    with pytest.raises(InvalidParameterError, match="size"):
+        render_preview(tmp_path / "a.png", mesh=m, size=(0, 10))
+    with pytest.raises(InvalidParameterError, match="view"):
+        render_preview(tmp_path / "a.png", mesh=m, view=(1, 2, 3))
+    with pytest.raises(InvalidParameterError, match="up"):
+        render_preview(tmp_path / "a.png", mesh=m, up="w")
+    with pytest.raises(InvalidParameterError, match="highlight"):
+        render_preview(tmp_path / "a.png", patches=true_patchset(box()), highlight=[6])
+    assert not any(tmp_path.iterdir())
+
+
+def test_import_is_light():
+    code = ("import sys, curvenet, curvenet.preview, curvenet.evaluate; "
+            "bad = [m for m in ('matplotlib', 'torch') if m in sys.modules]; "
+            "sys.exit(1 if bad else 0)")
+    assert subprocess.run([sys.executable, "-c", code]).returncode == 0
