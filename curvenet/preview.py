@@ -24,6 +24,9 @@ DEFAULT_VIEWS = ((20.0, -60.0), (20.0, 120.0))
 #: Meshes with more faces are decimated (vertex clustering) before drawing.
 MAX_PREVIEW_FACES = 60_000
 
+#: Patch fans are cut into this many rings (smaller pieces sort better in depth).
+FAN_RINGS = 4
+
 #: Camera zoom of each panel (matplotlib leaves room for the hidden axes at 1.0).
 ZOOM = 1.1
 
@@ -102,11 +105,24 @@ def _edge_ids(network, edge_ids) -> list:
     return ids
 
 
-def _fan(polygon):
-    """Fan triangles ``(k, 3, 3)`` of a closed polygon around its vertex centroid."""
+def _fan(polygon, rings: int = 1):
+    """Fan triangles ``(k (2 rings - 1), 3, 3)`` of a closed polygon around its centroid.
+
+    With ``rings > 1`` each fan sector (centroid, p_i, p_i+1) is cut by ``rings - 1``
+    scaled copies of the polygon into one triangle and ``rings - 1`` quads (two triangles
+    each). The surface is the same (every piece lies in its sector's plane); the smaller
+    pieces only help matplotlib's per-polygon depth sort.
+    """
     c = polygon.mean(axis=0)
-    nxt = np.roll(polygon, -1, axis=0)
-    return np.stack([np.broadcast_to(c, polygon.shape), polygon, nxt], axis=1)
+    k = len(polygon)
+    t = np.arange(1, rings + 1) / rings  # ring scale factors, outermost = 1
+    ring = c + t[:, None, None] * (polygon - c)[None]  # (rings, k, 3)
+    nxt = np.roll(ring, -1, axis=1)
+    inner = np.stack([np.broadcast_to(c, (k, 3)), ring[0], nxt[0]], axis=1)
+    a, b = ring[:-1].reshape(-1, 3), nxt[:-1].reshape(-1, 3)  # inner ring edge a -> b
+    a2, b2 = ring[1:].reshape(-1, 3), nxt[1:].reshape(-1, 3)  # outer ring edge a2 -> b2
+    quads = np.concatenate([np.stack([a, a2, b2], axis=1), np.stack([a, b2, b], axis=1)])
+    return np.concatenate([inner, quads])
 
 
 def decimate_clustering(vertices, faces, max_faces: int) -> tuple[np.ndarray, np.ndarray]:
@@ -337,7 +353,7 @@ def render_preview(path, *, strokes=None, network=None, patches=None, mesh=None,
     patch_tris, patch_rgb, patch_amb = [], [], []
     for edges, colour in fill:
         for poly in patch_polygons(network, edges):
-            t = _fan(poly)
+            t = _fan(poly, rings=FAN_RINGS)
             patch_tris.append(t)
             patch_rgb.append(np.broadcast_to(colour, (len(t), 3)))
             amb = HIGHLIGHT_AMBIENT if colour is HIGHLIGHT_COLOUR else AMBIENT

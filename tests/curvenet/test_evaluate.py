@@ -245,6 +245,19 @@ def test_stroke_distance_on_analytic_shape():
     assert net["stroke_max"] < 1e-9
 
 
+def test_geodesic_sketch_lies_on_its_mesh(data_dir):
+    """NeuralSketch2Surf's geodesic curves were traced on original_meshes/1.obj.
+
+    Coordinates are stored with 6 decimals: rounding moves a point by at most
+    0.5e-6 * sqrt(3) ~ 9e-7, i.e. ~4.5e-7 of the ~1.95 diagonal; 1e-5 leaves margin.
+    """
+    root = data_dir / "surfaces" / "neuralsketch2surf"
+    sketch = root / "sketch_dataset_112" / "geo" / "1_geo_N10_L100.obj"
+    d = stroke_distance(root / "original_meshes" / "1.obj", sketch)  # both as paths
+    assert d["stroke_max"] < 1e-5 and d["stroke_within_1pct"] == 1.0
+    assert d["n_stroke_samples"] > 1000
+
+
 # ---------------------------------------------------------------------------
 # inputs and errors
 # ---------------------------------------------------------------------------

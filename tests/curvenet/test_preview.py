@@ -133,6 +133,16 @@ def test_patch_polygons_walk_the_cycle():
     # planar face: all points on one plane
     centred = poly - poly.mean(axis=0)
     assert np.linalg.svd(centred, compute_uv=False)[-1] < 1e-12
+    # cutting the fan into rings keeps the surface: same area, same plane
+    from curvenet.preview import _fan
+
+    def area(t):
+        return 0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1)
+
+    one, four = _fan(poly), _fan(poly, rings=4)
+    assert four.shape == (32 * 7, 3, 3)
+    assert area(four).sum() == pytest.approx(area(one).sum(), rel=1e-12)
+    assert area(one).sum() == pytest.approx(1.0, rel=1e-12)  # a unit square face
     assert patch_polygons(net, loop[:3]) == []  # an open chain gives no polygon
     with pytest.raises(InvalidParameterError, match="out of range"):
         patch_polygons(net, [999])
