@@ -1,7 +1,8 @@
 """Coarse Catmull-Clark control mesh from curve loops (Orbay & Kara 2011, Sec. 4.2).
 
 Every network curve is resampled into ``N`` equal-arc-length segments (``2 N`` for a
-closed curve, one whose two ends are the same junction), and the samples become
+closed curve, one whose two ends are the same junction; with ``adaptive`` a multiple
+of ``N`` for long or winding curves, see :func:`curve_pieces`), and the samples become
 control vertices shared by every patch that uses the curve. Each loop is then filled
 with quads:
 
@@ -22,9 +23,9 @@ with quads:
 
   Geometry of a split loop: if its curves still form four geometric sides, the quad
   vertices are placed by a uniform (Tutte) embedding into the unit square and the
-  Coons patch of the four sides is evaluated there; otherwise each sub-quad is the
-  Coons patch of its two half-pieces and two straight spokes from the centre (the
-  mean of the loop's samples).
+  Coons patch of the four sides is evaluated there; otherwise the interior is the
+  uniform harmonic interpolant of the border (each inner vertex the mean of its
+  neighbours), which does not fold in concave loops as straight spokes would.
 
 No face is degenerate: every quad has four distinct vertices when ``N >= 2``
 (``N`` even). Quads run counter-clockwise along the loop's traversal, so loops that
@@ -50,10 +51,58 @@ from .coons import coons_eval, coons_grid
 from .polyline import resample
 from .sides import DEFAULT_STRAIGHT_ANGLE, group_sides
 
-__all__ = ["ControlMesh", "build_control_mesh", "orient_loops", "JUNCTION_TOL"]
+__all__ = ["ControlMesh", "build_control_mesh", "orient_loops", "curve_pieces", "JUNCTION_TOL"]
 
 #: Curve ends closer than this fraction of the bounding-box diagonal are one junction.
 JUNCTION_TOL = 1e-6
+#: Adaptive pieces: a curve gets one more piece of ``N`` segments per this many times the
+#: median curve length ...
+PIECE_LENGTH = 2.0
+#: ... and per this much total turning (degrees).
+PIECE_TURN = 120.0
+
+
+def curve_pieces(curves: list, closed: np.ndarray) -> np.ndarray:
+    """Pieces (of ``N`` control segments each) per curve for adaptive resolution.
+
+    ``max(1, ceil(length / (PIECE_LENGTH * median length)), ceil(turning / PIECE_TURN))``,
+    at least 2 for a closed curve. Turning is summed over the curve resampled at 32
+    segments (robust to sample noise).
+
+    Returns
+    -------
+    (C,) int64
+    """
+    lengths = np.array([np.linalg.norm(np.diff(c, axis=0), axis=1).sum() for c in curves])
+    med = float(np.median(lengths)) if len(lengths) else 1.0
+    turn = np.empty(len(curves))
+    for i, c in enumerate(curves):
+        d = np.diff(resample(c, 32), axis=0)
+        d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
+        turn[i] = np.degrees(np.arccos(np.clip((d[1:] * d[:-1]).sum(1), -1, 1))).sum()
+    m = np.maximum(np.ceil(lengths / (PIECE_LENGTH * max(med, 1e-300))),
+                   np.ceil(turn / PIECE_TURN))
+    m = np.maximum(m, 1).astype(np.int64)
+    return np.where(closed, np.maximum(m, 2), m)
+
+
+def _equalise_strips(m: np.ndarray, loops: list) -> np.ndarray:
+    """Raise piece counts so opposite curves of every four-curve loop agree.
+
+    Opposite curves of four-curve loops are joined into classes (the quad strips of
+    the layout); every curve of a class takes the class maximum, so those loops stay
+    regular ``p x q`` grids instead of falling back to a centre split.
+    """
+    C = len(m)
+    pairs = [(lp[k][0], lp[k + 2][0]) for lp in loops if len(lp) == 4 for k in (0, 1)]
+    if not pairs:
+        return m
+    pr = np.array(pairs, dtype=np.int64)
+    g = sp.coo_matrix((np.ones(len(pr)), (pr[:, 0], pr[:, 1])), shape=(C, C))
+    _, lab = connected_components(g, directed=False)
+    best = np.zeros(lab.max() + 1, dtype=np.int64)
+    np.maximum.at(best, lab, m)
+    return best[lab]
 
 
 @dataclass
@@ -213,14 +262,14 @@ def _grid_quads(G):
 
 
 def _tutte_square(quads_local, n_local, bnd_local, bnd_uv):
-    """Uniform harmonic embedding of a local quad mesh with the border pinned to ``bnd_uv``."""
+    """Uniform harmonic map of a local quad mesh with the border pinned to ``bnd_uv (b, d)``."""
     e = np.concatenate([quads_local[:, [0, 1]], quads_local[:, [1, 2]],
                         quads_local[:, [2, 3]], quads_local[:, [3, 0]]])
     A = sp.coo_matrix((np.ones(len(e)), (e[:, 0], e[:, 1])), shape=(n_local, n_local))
     A = ((A + A.T) > 0).astype(np.float64)
     deg = np.asarray(A.sum(axis=1)).ravel()
     Lap = sp.diags(deg) - A
-    uv = np.zeros((n_local, 2))
+    uv = np.zeros((n_local, bnd_uv.shape[1]))
     uv[bnd_local] = bnd_uv
     free = np.ones(n_local, bool)
     free[bnd_local] = False
@@ -234,7 +283,7 @@ def _tutte_square(quads_local, n_local, bnd_local, bnd_uv):
 
 def build_control_mesh(curves, loops, resolution: int = 4, *,
                        straight_angle: float = DEFAULT_STRAIGHT_ANGLE,
-                       orient: bool = True) -> ControlMesh:
+                       orient: bool = True, adaptive: bool = True) -> ControlMesh:
     """Stitch the loops' Coons patches into one quad control mesh.
 
     Parameters
@@ -250,6 +299,10 @@ def build_control_mesh(curves, loops, resolution: int = 4, *,
         Degrees; curves turning less at a junction belong to one side.
     orient : bool
         Repair loop orientation first (:func:`orient_loops`).
+    adaptive : bool
+        Give long or winding curves several pieces of ``N`` segments
+        (:func:`curve_pieces`), equalised along the quad strips of four-curve loops;
+        False: ``N`` per curve (``2 N`` if closed), as in the paper.
 
     Returns
     -------
@@ -273,7 +326,11 @@ def build_control_mesh(curves, loops, resolution: int = 4, *,
     n_j = len(jpos)
 
     # shared curve samples
-    k_c = np.where(jend[:, 0] == jend[:, 1], 2 * N, N)
+    closed = jend[:, 0] == jend[:, 1]
+    if adaptive:
+        k_c = N * _equalise_strips(curve_pieces(curves, closed), loops)
+    else:
+        k_c = N * np.where(closed, 2, 1)
     pos_blocks = [jpos]
     curve_vids = []
     samples = []
@@ -377,20 +434,15 @@ def build_control_mesh(curves, loops, resolution: int = 4, *,
             newpos = coons_eval(side_pts[0], side_pts[1], side_pts[2][::-1], side_pts[3][::-1],
                                 uv[Lb:])
         else:
-            cpos = BP.mean(axis=0)
-            spoke_pos = [cpos + np.linspace(0, 1, h + 1)[:, None] * (BP[(i * N + h) % Lb] - cpos)
-                         for i in range(T)]
-            newpos[0] = cpos
-            for i in range(T):
-                newpos[spokes[i][1:-1] - new_lo] = spoke_pos[i][1:-1]
-            for i, G in enumerate(subs):
-                bottom = spoke_pos[i]
-                left = spoke_pos[(i + 1) % T]
-                right = BP[(i * N + h + np.arange(h + 1)) % Lb]
-                top = BP[((i + 1) * N + h - np.arange(h + 1)) % Lb]
-                grid = coons_grid(bottom, right, top, left)
-                if h > 1:
-                    newpos[G[1:h, 1:h].ravel() - new_lo] = grid[1:h, 1:h].reshape(-1, 3)
+            # harmonic (uniform-weight) interior: the 3D image of a Tutte embedding into
+            # a convex polygon, so it cannot fold the way straight spokes do in a
+            # concave loop (the L of an L-prism)
+            quads_loc = np.concatenate([_grid_quads(G) for G in subs])
+            ids_all = np.concatenate([B, new_lo + np.arange(n_new)])
+            lut = {int(v): k for k, v in enumerate(ids_all)}
+            ql = np.vectorize(lut.__getitem__)(quads_loc)
+            xyz = _tutte_square(ql, len(ids_all), np.arange(Lb), BP)
+            newpos = xyz[Lb:]
         positions.append(newpos)
         q_loc = np.concatenate([_grid_quads(G) for G in subs])
         quads_all.append(q_loc)

@@ -1,0 +1,130 @@
+import numpy as np
+import pytest
+import trimesh
+
+from curvenet import shapes
+from surfacing.catmull_clark import edge_topology, euler_characteristic
+from surfacing.controlmesh import build_control_mesh, orient_loops
+
+
+def _tri(cm):
+    q = cm.quads
+    return trimesh.Trimesh(cm.vertices, np.concatenate([q[:, [0, 1, 2]], q[:, [0, 2, 3]]]),
+                           process=False)
+
+
+def _net(name):
+    s = shapes.SHAPES[name]()
+    return s, [e.curve for e in s.network.edges]
+
+
+@pytest.mark.parametrize("name", ["box", "l_prism", "house", "sphere", "ellipsoid",
+                                  "capped_cylinder", "torus", "grid_box"])
+def test_closed_shapes_give_closed_consistently_oriented_meshes(name):
+    s, curves = _net(name)
+    cm = build_control_mesh(curves, s.faces, 4)
+    m = _tri(cm)
+    assert m.is_watertight and m.is_winding_consistent and m.volume > 0
+    assert euler_characteristic(cm.quads, len(cm.vertices)) == 2 - 2 * s.genus
+    # no degenerate quad: four distinct vertices, non-zero area
+    assert all(len(set(q)) == 4 for q in cm.quads.tolist())
+    assert m.area_faces.min() > 0
+
+
+def test_shared_samples_are_shared_vertices():
+    s, curves = _net("box")
+    cm = build_control_mesh(curves, s.faces, 4)
+    # 8 junctions + 12 curves x 3 interior samples + 6 faces x 9 interior points
+    assert len(cm.vertices) == 8 + 12 * 3 + 6 * 9
+    for c, ids in enumerate(cm.curve_vids):
+        np.testing.assert_allclose(cm.vertices[ids[[0, -1]]], curves[c][[0, -1]], atol=1e-12)
+
+
+def test_inconsistent_loops_are_reoriented():
+    s, curves = _net("box")
+    loops = [list(lp) for lp in s.faces]
+    loops[2] = [(c, not f) for c, f in reversed(loops[2])]
+    fixed = orient_loops(loops, len(curves))
+    assert fixed[2] == list(s.faces[2])
+    cm = build_control_mesh(curves, loops, 4)
+    assert _tri(cm).is_winding_consistent
+
+
+def _seg(a, b):
+    t = np.linspace(0, 1, 9)[:, None]
+    return np.asarray(a, float) + t * (np.asarray(b, float) - a)
+
+
+def test_t_junctions_on_opposite_sides_give_one_grid():
+    # six curves, T-junctions at the middle of the bottom and the top: a 4-sided
+    # patch with sides of 2, 1, 2, 1 curves -> one 8 x 4 grid
+    curves = [_seg([0, 0, 0], [0.5, 0, 0]), _seg([0.5, 0, 0], [1, 0, 0]),
+              _seg([1, 0, 0], [1, 1, 0]), _seg([1, 1, 0], [0.5, 1, 0]),
+              _seg([0.5, 1, 0], [0, 1, 0]), _seg([0, 1, 0], [0, 0, 0])]
+    cm = build_control_mesh(curves, [[(i, True) for i in range(6)]], 4)
+    assert cm.patch_kind == ["grid"] and cm.quads.shape == (8 * 4, 4)
+    assert np.abs(cm.vertices[:, 2]).max() < 1e-12
+
+
+def test_five_curve_loop_is_four_sided():
+    # one T-junction: sides of 8, 4, 4, 4 segments cannot be one grid; the loop is
+    # still a 4-sided Coons patch, sampled through a Tutte embedding in the square
+    curves = [_seg([0, 0, 0], [0.5, 0, 0]), _seg([0.5, 0, 0], [1, 0, 0]),
+              _seg([1, 0, 0], [1, 1, 0.5]), _seg([1, 1, 0.5], [0, 1, 0.5]),
+              _seg([0, 1, 0.5], [0, 0, 0])]
+    cm = build_control_mesh(curves, [[(i, True) for i in range(5)]], 4)
+    assert cm.patch_kind == ["split-coons4"]
+    # the sides are straight, so the Coons patch is the ruled plane y = 2 z
+    np.testing.assert_allclose(cm.vertices[:, 2], 0.5 * cm.vertices[:, 1], atol=1e-12)
+    assert _tri(cm).area_faces.min() > 0
+
+
+def test_three_sided_and_six_sided_loops_split_around_a_centre():
+    s, curves = _net("sphere")
+    cm = build_control_mesh(curves, s.faces, 4)
+    tri_loops = [j for j, lp in enumerate(s.faces) if len(lp) == 3]
+    assert all(cm.patch_kind[j] == "split" for j in tri_loops)
+    # three sub-quads of 2 x 2 per triangle
+    assert all((cm.face_patch == j).sum() == 12 for j in tri_loops)
+    s, curves = _net("l_prism")
+    cm = build_control_mesh(curves, s.faces, 4)
+    assert sorted(cm.patch_kind).count("split") == 2
+
+
+def test_two_sided_and_one_sided_loops_have_no_degenerate_faces():
+    a = np.linspace(0, np.pi, 17)
+    upper = np.stack([np.cos(a), np.sin(a), 0 * a], 1)
+    lower = np.stack([np.cos(a), -np.sin(a), 0.2 * np.sin(a)], 1)[::-1]
+    # lens: two curves between (1,0,0) and (-1,0,0)
+    cm = build_control_mesh([upper, lower], [[(0, True), (1, True)]], 4)
+    assert cm.patch_kind == ["halves"]
+    assert all(len(set(q)) == 4 for q in cm.quads.tolist())
+    # closed stroke: one curve whose ends meet
+    b = np.linspace(0, 2 * np.pi, 33)
+    circle = np.stack([np.cos(b), np.sin(b), 0 * b], 1)
+    cm = build_control_mesh([circle], [[(0, True)]], 4)
+    assert cm.patch_kind == ["halves"] and cm.quads.shape == (4, 4)     # 2N = 8 samples
+    assert all(len(set(q)) == 4 for q in cm.quads.tolist())
+    assert _tri(cm).area_faces.min() > 0
+
+
+def test_non_manifold_curve_is_shared_by_the_pieces():
+    s, curves = _net("two_boxes")
+    cm = build_control_mesh(curves, s.faces, 4)
+    topo = edge_topology(cm.quads, len(cm.vertices))
+    assert (topo.face_count == 3).any() and (topo.face_count <= 3).all()
+    assert _tri(cm).is_winding_consistent
+
+
+@pytest.mark.parametrize("bad", [0, 3, -2])
+def test_resolution_validated(bad):
+    s, curves = _net("box")
+    with pytest.raises(ValueError, match="resolution"):
+        build_control_mesh(curves, s.faces, bad)
+
+
+def test_bad_loops_rejected():
+    with pytest.raises(ValueError, match="out of range"):
+        build_control_mesh([np.zeros((2, 3)) + [[0, 0, 0], [1, 0, 0]]], [[(3, True)]], 4)
+    with pytest.raises(ValueError, match="curves\\[0\\]"):
+        build_control_mesh([np.zeros((1, 3))], [[(0, True)]], 4)
