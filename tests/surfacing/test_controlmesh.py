@@ -96,14 +96,17 @@ def test_two_sided_and_one_sided_loops_have_no_degenerate_faces():
     upper = np.stack([np.cos(a), np.sin(a), 0 * a], 1)
     lower = np.stack([np.cos(a), -np.sin(a), 0.2 * np.sin(a)], 1)[::-1]
     # lens: two curves between (1,0,0) and (-1,0,0)
-    cm = build_control_mesh([upper, lower], [[(0, True), (1, True)]], 4)
+    cm = build_control_mesh([upper, lower], [[(0, True), (1, True)]], 4, adaptive=False)
     assert cm.patch_kind == ["halves"]
     assert all(len(set(q)) == 4 for q in cm.quads.tolist())
     # closed stroke: one curve whose ends meet
     b = np.linspace(0, 2 * np.pi, 33)
     circle = np.stack([np.cos(b), np.sin(b), 0 * b], 1)
-    cm = build_control_mesh([circle], [[(0, True)]], 4)
+    cm = build_control_mesh([circle], [[(0, True)]], 4, adaptive=False)
     assert cm.patch_kind == ["halves"] and cm.quads.shape == (4, 4)     # 2N = 8 samples
+    # adaptive: 360 degrees of turning -> 3 pieces of 4 -> a three-sided split
+    cm = build_control_mesh([circle], [[(0, True)]], 4)
+    assert cm.patch_kind == ["split"] and cm.quads.shape == (12, 4)
     assert all(len(set(q)) == 4 for q in cm.quads.tolist())
     assert _tri(cm).area_faces.min() > 0
 
@@ -114,6 +117,23 @@ def test_non_manifold_curve_is_shared_by_the_pieces():
     topo = edge_topology(cm.quads, len(cm.vertices))
     assert (topo.face_count == 3).any() and (topo.face_count <= 3).all()
     assert _tri(cm).is_winding_consistent
+
+
+def test_adaptive_pieces_follow_quad_strips():
+    from surfacing.controlmesh import curve_pieces
+    t = np.linspace(0, 1, 33)[:, None]
+    curves = [t * [3, 0, 0], [3, 0, 0] + t * [0, 1, 0], [3, 1, 0] - t * [3, 0, 0],
+              [0, 1, 0] - t * [0, 1, 0]]
+    # lengths 3, 1, 3, 1: median 2, so no curve exceeds 2 x median -> one piece each
+    np.testing.assert_array_equal(curve_pieces(curves, np.zeros(4, bool)), [1, 1, 1, 1])
+    # a wavy bottom turns by more than 120 degrees in total -> more pieces; the
+    # opposite curve follows so the loop stays one grid
+    curves[0] = np.concatenate([3 * t, 0 * t, 0.1 * np.sin(6 * np.pi * t)], 1)
+    m = curve_pieces(curves, np.zeros(4, bool))
+    assert m[0] >= 2 and m[1] == m[2] == m[3] == 1
+    cm = build_control_mesh(curves, [[(i, True) for i in range(4)]], 4)
+    assert [len(v) - 1 for v in cm.curve_vids] == [4 * m[0], 4, 4 * m[0], 4]
+    assert cm.patch_kind == ["grid"]
 
 
 @pytest.mark.parametrize("bad", [0, 3, -2])
