@@ -92,9 +92,9 @@ class _Strokes:
     def __init__(self):
         self.polys, self.cums, self.srcs, self.labels = [], [], [], []
 
-    def add(self, poly, srcs, label):
+    def add(self, poly, srcs, label, cum=None):
         self.polys.append(poly)
-        self.cums.append(_arclength(poly))
+        self.cums.append(_arclength(poly) if cum is None else cum)
         self.srcs.append(tuple(sorted(set(srcs))))
         self.labels.append(label)
 
@@ -109,21 +109,56 @@ class _Strokes:
         return self.cums[k][-1]
 
 
+class _Flat:
+    """All strokes concatenated, for vectorised arc-length lookups.
+
+    Stroke ``k``'s points are ``P[first[k]:first[k] + count[k]]``; its arc
+    parameter ``s`` maps to the global parameter ``s + off[k]`` on the
+    concatenated polyline, where consecutive strokes are separated by a gap of
+    ``sep`` (so a lookup never lands on the joining segment's interior).
+    """
+
+    def __init__(self, st):
+        self.count = np.array([len(p) for p in st.polys])
+        self.first = np.concatenate([[0], np.cumsum(self.count)[:-1]])
+        self.P = np.concatenate(st.polys)
+        self.L = np.array([c[-1] for c in st.cums])
+        sep = float(self.L.sum()) + 1.0
+        self.off = np.concatenate([[0.0], np.cumsum(self.L + sep)[:-1]])
+        self.G = np.concatenate([c + o for c, o in zip(st.cums, self.off)])
+
+    def interp(self, k, s):
+        """Points ``(m, 3)`` at arc parameters ``s (m,)`` of strokes ``k (m,)`` (clamped)."""
+        k = np.asarray(k, dtype=np.int64)
+        g = np.clip(np.asarray(s, dtype=np.float64), 0.0, self.L[k]) + self.off[k]
+        j = np.clip(np.searchsorted(self.G, g, side="right") - 1, 0, len(self.G) - 2)
+        seg = self.G[j + 1] - self.G[j]
+        t = np.clip((g - self.G[j]) / np.maximum(seg, 1e-300), 0.0, 1.0)  # guard 0-length
+        return self.P[j] + t[:, None] * (self.P[j + 1] - self.P[j])
+
+
 def _sample(st, h):
-    """Uniform samples: points (M,3), stroke id (M,), arc param (M,), unit tangent (M,3)."""
-    pts, sid, ss, tan = [], [], [], []
-    for k in range(len(st)):
-        L = st.length(k)
-        n = max(2, int(np.ceil(L / h)) + 1)
-        s = np.linspace(0.0, L, n)
-        p = _interp(st.polys[k], st.cums[k], s)
-        t = np.gradient(p, axis=0)
-        t /= np.maximum(np.linalg.norm(t, axis=1, keepdims=True), 1e-300)  # guard 0-length
-        pts.append(p)
-        sid.append(np.full(n, k))
-        ss.append(s)
-        tan.append(t)
-    return (np.concatenate(pts), np.concatenate(sid), np.concatenate(ss), np.concatenate(tan))
+    """Uniform samples of every stroke at spacing <= h.
+
+    Returns
+    -------
+    (Q, sid, ss, tan, start) : points (M, 3), stroke id (M,), arc parameter (M,),
+        unit tangent (M, 3), and ``start (S + 1,)`` with stroke k's samples at
+        ``start[k]:start[k + 1]``.
+    """
+    flat = _Flat(st)
+    n = np.maximum(2, np.ceil(flat.L / h).astype(np.int64) + 1)
+    start = np.concatenate([[0], np.cumsum(n)])
+    sid = np.repeat(np.arange(len(n)), n)
+    local = np.arange(start[-1]) - start[sid]
+    ss = local * (flat.L / (n - 1))[sid]
+    ss[start[1:] - 1] = flat.L  # exact ends
+    Q = flat.interp(sid, ss)
+    nxt = np.minimum(np.arange(len(Q)) + 1, start[sid + 1] - 1)
+    prv = np.maximum(np.arange(len(Q)) - 1, start[sid])
+    tan = Q[nxt] - Q[prv]
+    tan /= np.maximum(np.linalg.norm(tan, axis=1, keepdims=True), 1e-300)  # guard 0-length
+    return Q, sid, ss, tan, start, flat
 
 
 def _contacts(samples, tol, h, st, opts):
@@ -132,7 +167,7 @@ def _contacts(samples, tol, h, st, opts):
     Returns a structured dict of arrays, one entry per contact: strokes ``a < b``,
     extents on each, closest pair ``(i, j)`` (sample indices), ``overlap`` flag.
     """
-    Q, sid, ss, tan = samples
+    Q, sid, ss, tan = samples[:4]
     pairs = cKDTree(Q).query_pairs(tol, output_type="ndarray")
     empty = {k: np.zeros(0, dtype=np.int64) for k in ("a", "b", "i", "j")}
     if len(pairs) == 0:
@@ -178,7 +213,7 @@ def _contacts(samples, tol, h, st, opts):
 # --------------------------------------------------------------------------- overdraw
 def _consolidate(st, samples, con, tol, h, opts, report):
     """Average each overdrawn stretch into its host and cut it out of the guest."""
-    Q, sid, ss, _ = samples
+    Q, _, ss, _, start, _ = samples
     idx = np.flatnonzero(con["overlap"])
     span = np.minimum(con["a1"] - con["a0"], con["b1"] - con["b0"])[idx]
     idx = idx[np.argsort(-span, kind="stable")]
@@ -198,8 +233,20 @@ def _consolidate(st, samples, con, tol, h, opts, report):
         else:
             guest, host = b, a
             g0, g1, h0, h1 = con["b0"][c], con["b1"][c], con["a0"][c], con["a1"][c]
+        # the guest is covered only where its closest host sample is not a host end:
+        # a guest running on past the host's end is a continuation, not overdraw
+        hm = slice(start[host], start[host + 1])
+        hs = ss[hm]
+        lo_g = start[guest] + np.searchsorted(ss[start[guest]:start[guest + 1]], g0 - tol)
+        hi_g = start[guest] + np.searchsorted(ss[start[guest]:start[guest + 1]], g1 + tol,
+                                              side="right")
+        gm = slice(lo_g, hi_g)
+        dist, nn = cKDTree(Q[hm]).query(Q[gm])
+        cov = (dist <= tol) & (hs[nn] > 0.5 * h) & (hs[nn] < st.length(host) - 0.5 * h)
+        if not cov.any():
+            continue
+        g0, g1 = ss[gm][cov].min(), ss[gm][cov].max()
         # host: move halfway onto the guest over [h0, h1], tapered over `ramp` at both ends
-        gm = (sid == guest) & (ss >= g0 - tol) & (ss <= g1 + tol)
         gtree = cKDTree(Q[gm])
         hp, hc = st.polys[host], st.cums[host]
         inside = (hc >= h0) & (hc <= h1)
@@ -243,7 +290,7 @@ def _consolidate(st, samples, con, tol, h, opts, report):
     out = _Strokes()
     for k in range(len(st)):
         if k not in removed:
-            out.add(st.polys[k], st.srcs[k], st.labels[k])
+            out.add(st.polys[k], st.srcs[k], st.labels[k], st.cums[k])
     for p, s, lab in new:
         out.add(p, s, lab)
     return out
@@ -259,7 +306,7 @@ def _cut(poly, cum, a, b):
 # --------------------------------------------------------------------------- junctions
 def _candidates(st, samples, con, tol, h):
     """Junction candidates: positions (m,3) and members [(stroke, s), ...] per candidate."""
-    Q, sid, ss, _ = samples
+    Q, sid, ss = samples[:3]
     pos, members = [], []
     keep = np.flatnonzero(~con["overlap"])
     for c in keep:
@@ -286,17 +333,42 @@ def _candidates(st, samples, con, tol, h):
     return np.array(pos).reshape(-1, 3), members, closed
 
 
-def _closest_param(st, k, lo, hi, target, h):
-    """Arc parameter in ``[lo, hi]`` of stroke ``k`` closest to ``target`` (h-resolution)."""
-    L = st.length(k)
-    lo, hi = max(0.0, lo), min(L, hi)
-    n = max(2, int(np.ceil((hi - lo) / (0.25 * h))) + 1)
-    s = np.linspace(lo, hi, n)
-    p = _interp(st.polys[k], st.cums[k], s)
-    return float(s[np.argmin(np.linalg.norm(p - target, axis=1))])
+def _closest_params(samples, k, lo, hi, target, h):
+    """Arc parameters in ``[lo, hi]`` of strokes ``k`` closest to ``target``, batched.
+
+    Parameters
+    ----------
+    k : (m,) int64; lo, hi : (m,) float64; target : (m, 3) float64
+
+    Returns
+    -------
+    (m,) float64
+        The nearest sample in the window, refined on a grid of ``h / 4`` around it.
+    """
+    Q, sid, ss, _, start, flat = samples
+    k = np.asarray(k, dtype=np.int64)
+    lo = np.maximum(0.0, lo)
+    hi = np.minimum(flat.L[k], hi)
+    gs = ss + flat.off[sid]  # global sample parameter, increasing
+    i0 = np.searchsorted(gs, lo + flat.off[k])
+    i1 = np.searchsorted(gs, hi + flat.off[k], side="right")
+    i0 = np.clip(i0, start[k], start[k + 1] - 1)
+    i1 = np.clip(np.maximum(i1, i0 + 1), start[k] + 1, start[k + 1])
+    lens = i1 - i0
+    q = np.repeat(np.arange(len(k)), lens)
+    idx = np.repeat(i0, lens) + (np.arange(lens.sum()) - np.repeat(np.cumsum(lens) - lens, lens))
+    d = np.linalg.norm(Q[idx] - target[q], axis=1)
+    order = np.lexsort((d, q))
+    first = np.concatenate([[0], np.cumsum(lens)[:-1]])
+    best = idx[order[first]]
+    grid = np.linspace(-h, h, 9)
+    fine = np.clip(ss[best][:, None] + grid[None, :], lo[:, None], hi[:, None])  # (m, 9)
+    p = flat.interp(np.repeat(k, 9), fine.ravel()).reshape(-1, 9, 3)
+    pick = np.argmin(np.linalg.norm(p - target[:, None, :], axis=2), axis=1)
+    return fine[np.arange(len(k)), pick]
 
 
-def _cluster(st, pos, members, tol, h, opts):
+def _cluster(samples, pos, members, tol, h, opts):
     """Merge candidates into junctions; returns (positions, per-stroke member lists).
 
     Per-stroke member list: sorted list of (s, junction id). Candidates within
@@ -317,12 +389,19 @@ def _cluster(st, pos, members, tol, h, opts):
         for c, mem in enumerate(members):
             for k, s in mem:
                 raw.setdefault((int(cid[c]), k), []).append(s)
-        per_stroke = {}
+        qk, qlo, qhi, qj = [], [], [], []
         for (jn, k), svals in sorted(raw.items()):
             svals = np.sort(np.asarray(svals))
             runs = np.split(svals, np.flatnonzero(np.diff(svals) > 2.0 * tol) + 1)
             for r in runs:
-                s = _closest_param(st, k, r[0] - tol, r[-1] + tol, J[jn], h)
+                qk.append(k)
+                qlo.append(r[0] - tol)
+                qhi.append(r[-1] + tol)
+                qj.append(jn)
+        per_stroke = {}
+        if qk:
+            qs = _closest_params(samples, qk, np.array(qlo), np.array(qhi), J[qj], h)
+            for k, s, jn in zip(qk, qs.tolist(), qj):
                 per_stroke.setdefault(k, []).append((s, jn))
         changed = False
         first_member = {}  # junction -> a candidate index, to union by candidate
@@ -349,26 +428,39 @@ def _cluster(st, pos, members, tol, h, opts):
     return J, per_stroke
 
 
-def _corners(st, k, tol, h, opts):
-    """Arc parameters of sharp turns of stroke ``k`` (local maxima above the threshold)."""
-    L = st.length(k)
+def _corners(samples, tol, h, opts):
+    """Sharp turns: ``{stroke: [s, ...]}``, local maxima of the turn above the threshold.
+
+    The turn at ``s`` is the angle between the chords ``p(s - w) -> p(s)`` and
+    ``p(s) -> p(s + w)``, ``w = corner_window * tol``, evaluated every ``h / 2``
+    on all strokes at once.
+    """
+    flat = samples[5]
     w = opts.corner_window * tol
-    if L <= 2 * w or opts.corner_angle >= 180:
-        return []
-    n = max(3, int(np.ceil((L - 2 * w) / (0.5 * h))) + 1)
-    s = np.linspace(w, L - w, n)
-    poly, cum = st.polys[k], st.cums[k]
-    p0, p1, p2 = (_interp(poly, cum, s - w), _interp(poly, cum, s), _interp(poly, cum, s + w))
+    ok = np.flatnonzero(flat.L > 2 * w)
+    if opts.corner_angle >= 180 or ok.size == 0:
+        return {}
+    n = np.maximum(3, np.ceil((flat.L[ok] - 2 * w) / (0.5 * h)).astype(np.int64) + 1)
+    pad = int(np.ceil(w / (0.5 * h))) + 1  # -1 entries between strokes stop the filter
+    start = np.concatenate([[0], np.cumsum(n + pad)])
+    kk = np.repeat(ok, n)
+    rel = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)
+    s = w + rel * np.repeat((flat.L[ok] - 2 * w) / (n - 1), n)
+    pos = rel + np.repeat(start[:-1], n)
+    p0, p1, p2 = flat.interp(kk, s - w), flat.interp(kk, s), flat.interp(kk, s + w)
     u, v = p1 - p0, p2 - p1
-    nu = np.maximum(np.linalg.norm(u, axis=1), 1e-300)
+    nu = np.maximum(np.linalg.norm(u, axis=1), 1e-300)  # guard 0-length chords
     nv = np.maximum(np.linalg.norm(v, axis=1), 1e-300)
-    ang = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", u, v) / (nu * nv), -1, 1)))
-    size = 2 * int(np.ceil(w / (0.5 * h))) + 1
-    peak = (ang >= maximum_filter1d(ang, size, mode="nearest")) & (ang > opts.corner_angle)
-    out = []
-    for q in np.flatnonzero(peak):
-        if not out or s[q] - out[-1] > w:
-            out.append(float(s[q]))
+    ang = np.full(start[-1], -1.0)
+    ang[pos] = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", u, v) / (nu * nv), -1, 1)))
+    peak = (ang >= maximum_filter1d(ang, 2 * pad - 1, mode="nearest")) & (ang > opts.corner_angle)
+    out = {}
+    inv = -np.ones(start[-1], dtype=np.int64)
+    inv[pos] = np.arange(len(pos))
+    for q in inv[np.flatnonzero(peak)]:
+        lst = out.setdefault(int(kk[q]), [])
+        if not lst or s[q] - lst[-1] > w:
+            lst.append(float(s[q]))
     return out
 
 
@@ -413,47 +505,50 @@ def _displace_and_split(poly, cum, cuts, disp, tol, opts):
 
 
 def _tangent_at(curve, at_start, w):
-    """Unit direction leaving the curve's start (or end), over a chord of length ``w``."""
+    """Unit direction leaving the curve's start (or end): towards the first point ``>= w`` away."""
     c = curve if at_start else curve[::-1]
-    cum = _arclength(c)
-    p = _interp(c, cum, np.array([min(w, cum[-1])]))[0]
-    d = p - c[0]
-    return d / max(np.linalg.norm(d), 1e-300)
+    d = np.linalg.norm(c - c[0], axis=1)
+    far = np.flatnonzero(d >= w)
+    vec = c[far[0] if far.size else -1] - c[0]
+    return vec / max(np.linalg.norm(vec), 1e-300)  # guard: degenerate curve
 
 
 def _dissolve(edges, corner_ids, tol, opts, nverts):
-    """Join the two edges at each smooth degree-2 vertex that is not a corner."""
+    """Join the two edges at each smooth degree-2 vertex that is not a corner.
+
+    ``edges`` is a list of ``(u, v, curve, sources, label)``; vertices are visited
+    in increasing id, each once, with the incidence updated after each join.
+    """
     count = 0
-    changed = True
-    while changed:
-        changed = False
-        inc = [[] for _ in range(nverts)]
-        for e_id, e in enumerate(edges):
-            if e is None:
-                continue
-            inc[e[0]].append(e_id)
-            inc[e[1]].append(e_id)
-        for v in range(nverts):
-            if len(inc[v]) != 2 or v in corner_ids or inc[v][0] == inc[v][1]:
-                continue
-            e1, e2 = edges[inc[v][0]], edges[inc[v][1]]
-            c1 = e1[2] if e1[1] == v else e1[2][::-1]  # ends at v
-            u1 = e1[0] if e1[1] == v else e1[1]
-            c2 = e2[2] if e2[0] == v else e2[2][::-1]  # starts at v
-            w2 = e2[1] if e2[0] == v else e2[0]
-            w = opts.corner_window * tol
-            t1 = -_tangent_at(c1, False, w)
-            t2 = _tangent_at(c2, True, w)
-            turn = np.degrees(np.arccos(np.clip(t1 @ t2, -1, 1)))
-            if turn >= opts.corner_angle:
-                continue
-            label = "crease" if "crease" in (e1[4], e2[4]) else "boundary"
-            edges[inc[v][0]] = (u1, w2, np.vstack([c1, c2[1:]]),
-                                tuple(sorted(set(e1[3]) | set(e2[3]))), label)
-            edges[inc[v][1]] = None
-            count += 1
-            changed = True
-            break
+    inc = [set() for _ in range(nverts)]
+    for e_id, e in enumerate(edges):
+        inc[e[0]].add(e_id)
+        inc[e[1]].add(e_id)
+    w = opts.corner_window * tol
+    for v in range(nverts):
+        if len(inc[v]) != 2 or v in corner_ids:
+            continue
+        i1, i2 = sorted(inc[v])
+        e1, e2 = edges[i1], edges[i2]
+        if e1[0] == e1[1] or e2[0] == e2[1]:
+            continue
+        c1 = e1[2] if e1[1] == v else e1[2][::-1]  # ends at v
+        u1 = e1[0] if e1[1] == v else e1[1]
+        c2 = e2[2] if e2[0] == v else e2[2][::-1]  # starts at v
+        w2 = e2[1] if e2[0] == v else e2[0]
+        turn = np.degrees(np.arccos(np.clip(-_tangent_at(c1, False, w) @ _tangent_at(c2, True, w),
+                                            -1, 1)))
+        if turn >= opts.corner_angle:
+            continue
+        label = "crease" if "crease" in (e1[4], e2[4]) else "boundary"
+        edges[i1] = (u1, w2, np.vstack([c1, c2[1:]]), tuple(sorted(set(e1[3]) | set(e2[3]))),
+                     label)
+        edges[i2] = None
+        inc[v].clear()
+        inc[w2].discard(i2)
+        inc[w2].add(i1)
+        inc[u1].add(i1)
+        count += 1
     return [e for e in edges if e is not None], count
 
 
@@ -520,14 +615,14 @@ def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
             report["warnings"].append("overdraw left after 12 rounds; treated as crossings")
             con["overlap"][:] = False
     pos, members, report["closed_strokes"] = _candidates(st, samples, con, tol, h)
-    J, per_stroke = _cluster(st, pos, members, tol, h, opts)
+    J, per_stroke = _cluster(samples, pos, members, tol, h, opts)
     nj = len(J)
     verts = [p for p in J]
     corner_ids = set()
-    for k in range(len(st)):  # corners: degree-2 vertices, no displacement
+    for k, found in sorted(_corners(samples, tol, h, opts).items()):  # degree-2 vertices
         taken = [s for s, _ in per_stroke.get(k, [])]
-        for s in _corners(st, k, tol, h, opts):
-            if all(abs(s - t) > tol for t in taken):
+        for s in found:
+            if all(abs(s - t) > 2.0 * tol for t in taken):
                 vid = len(verts)
                 verts.append(_interp(st.polys[k], st.cums[k], np.array([s]))[0])
                 corner_ids.add(vid)
@@ -537,6 +632,8 @@ def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
     ends_at = np.zeros(len(verts), np.int64)
     through = np.zeros(len(verts), np.int64)
     edges = []
+    verts_arr = np.array(verts).reshape(-1, 3)
+    flat = samples[5]
     for k in range(len(st)):
         poly, cum = st.polys[k], st.cums[k]
         L = cum[-1]
@@ -550,8 +647,8 @@ def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
                 ends_at[j] += 1
             else:
                 through[j] += 1
-        disp = np.array([verts[j] - _interp(poly, cum, np.array([s]))[0] for s, j in lst]
-                        ).reshape(-1, 3)
+        disp = verts_arr[ids] - flat.interp(np.full(len(cuts), k), cuts) if ids else \
+            np.zeros((0, 3))
         pieces = _displace_and_split(poly, cum, cuts, disp, tol, opts)
         lab = st.labels[k]
         for q, piece in enumerate(pieces):

@@ -166,18 +166,26 @@ def _prepare(sketch, opts):
 
 def _is_exact(strokes, diag):
     """Whether every stroke end coincides with a point of another stroke or its own end."""
+    counts = np.array([len(s) for s in strokes])
     pts = np.concatenate(strokes)
-    sid = np.repeat(np.arange(len(strokes)), [len(s) for s in strokes])
-    n = np.cumsum([len(s) for s in strokes])
-    first, last = n - np.array([len(s) for s in strokes]), n - 1
+    sid = np.repeat(np.arange(len(strokes)), counts)
+    last = np.cumsum(counts) - 1
+    first = last - counts + 1
     eps = _EXACT_EPS * diag
     closed = np.linalg.norm(pts[first] - pts[last], axis=1) <= eps
-    pairs = cKDTree(pts).query_pairs(eps, output_type="ndarray")
-    pairs = pairs[sid[pairs[:, 0]] != sid[pairs[:, 1]]]
-    attached = np.zeros(len(pts), dtype=bool)
-    attached[pairs.ravel()] = True
-    ok = (attached[first] | closed) & (attached[last] | closed)
-    return bool(ok.all()) and (len(strokes) > 1 or bool(closed.all()))
+    ends = np.concatenate([first, last])
+    tree = cKDTree(pts)
+    kq = min(8, len(pts))
+    dist, nn = tree.query(pts[ends], k=kq, distance_upper_bound=eps)
+    nn = nn.reshape(len(ends), kq)
+    hit = np.isfinite(dist.reshape(len(ends), kq))
+    other = hit & (sid[np.minimum(nn, len(pts) - 1)] != sid[ends][:, None])
+    attached = other.any(axis=1) | np.concatenate([closed, closed])
+    if hit.all(axis=1).any():  # 8 coincident points or more: fall back to a ball query
+        for q in np.flatnonzero(hit.all(axis=1)):
+            near = tree.query_ball_point(pts[ends[q]], eps)
+            attached[q] = bool(np.any(sid[near] != sid[ends[q]]))
+    return bool(attached.all()) and (len(strokes) > 1 or bool(closed.all()))
 
 
 def _snap_exact(strokes, src, labels, diag):

@@ -1,0 +1,78 @@
+"""Benchmark: snapping rough sketches (target: 1,000 strokes x 100 points in < 2 s).
+
+Run ``python benchmarks/bench_snap.py``. Prints one row per case: strokes,
+points, seconds (best of ``--repeat``), and whether the snapped graph matches
+the clean network it was re-drawn from (:func:`curvenet.redraw.match_networks`).
+
+The large case is a saddle grid re-drawn rough with every redraw amplitude and
+the snapping tolerance scaled by ``4 / n`` (so each grid cell looks like the
+n = 4 test case), trimmed to 1,000 strokes resampled to 100 points each.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import numpy as np
+
+from curvenet import shapes
+from curvenet.redraw import match_networks, rough_sketch
+from curvenet.sketch import Sketch
+from curvenet.snap import DEFAULT_SNAP_TOL, snap
+
+
+def _resample(stroke, n):
+    cum = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(stroke, axis=0), axis=1))])
+    s = np.linspace(0.0, cum[-1], n)
+    return np.stack([np.interp(s, cum, stroke[:, k]) for k in range(3)], axis=1)
+
+
+def grid_case(n: int, seed: int, *, points: int = 100, max_strokes: int | None = None):
+    """(sketch, reference network, snap_tol) for a rough saddle grid of size n."""
+    ref = shapes.saddle_grid(n).network
+    f = 4.0 / n
+    sk = rough_sketch(ref, seed=seed, wobble=0.003 * f, overshoot=0.015 * f, gap=0.01 * f)
+    strokes = [_resample(s, points) for s in sk.strokes]
+    labels = list(sk.labels)
+    if max_strokes is not None:
+        strokes, labels = strokes[:max_strokes], labels[:max_strokes]
+    return Sketch(strokes, labels), ref, DEFAULT_SNAP_TOL * f
+
+
+def _time(fn, repeat):
+    best = np.inf
+    out = None
+    for _ in range(repeat):
+        t = time.perf_counter()
+        out = fn()
+        best = min(best, time.perf_counter() - t)
+    return best, out
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=3)
+    args = ap.parse_args(argv)
+    rows = []
+    for name in ("box", "l_prism", "latlong_sphere", "saddle_grid"):
+        ref = getattr(shapes, name)().network
+        sk = rough_sketch(ref, seed=0)
+        t, net = _time(lambda sk=sk: snap(sk), args.repeat)
+        rows.append((f"{name} rough", len(sk), len(sk.points), t, match_networks(ref, net)["ok"]))
+    for n in (10, 20):
+        sk, ref, tol = grid_case(n, seed=0)
+        t, net = _time(lambda sk=sk, tol=tol: snap(sk, snap_tol=tol), args.repeat)
+        rows.append((f"saddle_grid({n}) rough", len(sk), len(sk.points), t,
+                     match_networks(ref, net)["ok"]))
+    sk, ref, tol = grid_case(20, seed=1, max_strokes=1000)
+    t, net = _time(lambda: snap(sk, snap_tol=tol), args.repeat)
+    rows.append(("1000 strokes x 100 pts", len(sk), len(sk.points), t, "-"))
+    print(f"{'case':28s} {'strokes':>8s} {'points':>8s} {'seconds':>8s}  graph ok")
+    for name, ns, npt, t, ok in rows:
+        print(f"{name:28s} {ns:8d} {npt:8d} {t:8.3f}  {ok}")
+    print("target: 1000 strokes x 100 points < 2 s")
+
+
+if __name__ == "__main__":
+    main()
