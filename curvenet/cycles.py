@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import time
 from collections import deque
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -46,6 +45,10 @@ __all__ = ["find_patches", "cycle_to_loop", "orient_patches", "closing_suggestio
 SEPARATING_EPS = 0.5
 #: Tie-break measures for cycles of equal ``k`` (see :func:`find_patches`).
 TIE_BREAKS = ("pca", "aabb")
+#: Enumeration kernels of :class:`CandidatePool`.
+ENGINES = ("auto", "python", "numba")
+#: ``engine="auto"`` compiles the search with numba from this many curves on.
+NUMBA_MIN_EDGES = 150
 #: Default bound on search steps of the candidate enumeration (one step = one
 #: path extension); about a second of pure Python.
 DEFAULT_MAX_WORK = 1_000_000
@@ -64,7 +67,6 @@ _SMOOTH_DEG = 30.0
 _MAX_NULL_ENUM = 8
 
 
-@dataclass
 class Candidate:
     """One candidate cycle with its Sec. 4.2 weight.
 
@@ -73,7 +75,7 @@ class Candidate:
     edges : tuple of int
         Sorted edge ids.
     mask : int
-        Bitset of ``edges``.
+        Bitset of ``edges`` (computed on first use).
     length : int
         Number of edges.
     vertices : tuple of int
@@ -90,14 +92,27 @@ class Candidate:
         pass only classifies cycles independent of the basis so far).
     """
 
-    edges: tuple
-    mask: int
-    length: int
-    vertices: tuple
-    volume: float
-    area: float
-    geo: tuple
-    separating: bool | None = None
+    __slots__ = ("edges", "length", "vertices", "volume", "area", "geo", "separating", "_mask")
+
+    def __init__(self, edges, length, vertices, volume, area, geo, separating=None):
+        self.edges = edges
+        self.length = length
+        self.vertices = vertices
+        self.volume = volume
+        self.area = area
+        self.geo = geo
+        self.separating = separating
+        self._mask = None
+
+    def __repr__(self) -> str:
+        return (f"Candidate(edges={self.edges}, volume={self.volume:g}, "
+                f"separating={self.separating})")
+
+    @property
+    def mask(self) -> int:
+        if self._mask is None:
+            self._mask = edge_mask(self.edges)
+        return self._mask
 
     @property
     def k(self) -> float:
@@ -127,6 +142,10 @@ class CandidatePool:
     max_work : int
         Budget of search steps over the pool's lifetime; once spent,
         ``work_bound_hit`` is set and enumeration stops.
+    engine : {"auto", "python", "numba"}
+        Enumeration kernel: pure Python, or the same search compiled with numba
+        (cached on disk after the first compilation). ``"auto"`` uses numba for
+        networks with at least :data:`NUMBA_MIN_EDGES` curves when numba imports.
 
     Notes
     -----
@@ -138,9 +157,12 @@ class CandidatePool:
     """
 
     def __init__(self, network: CurveNetwork, *, tie_break: str = "pca",
-                 max_work: int = DEFAULT_MAX_WORK):
+                 max_work: int = DEFAULT_MAX_WORK, engine: str = "auto"):
+        if engine not in ENGINES:
+            raise InvalidParameterError(f"engine: expected one of {ENGINES}, got {engine!r}")
         self.network = network
         self.tie_break = tie_break
+        self.engine = engine
         self.max_work = int(max_work)
         self.work = 0
         self.work_bound_hit = False
@@ -158,6 +180,7 @@ class CandidatePool:
         self.nbrs = [sorted({y for y, _ in lst}) for lst in self.adj]
         self.loops = [e for e, (u, v) in enumerate(ends.tolist()) if u == v]
         self._dist = [None] * nv
+        self._csr = None
         self._sep_cache: dict = {}
         self._comp = self._components()
         self.cycle_rank = ne - nv + int(self._comp.max() + 1 if nv else 0)
@@ -299,17 +322,25 @@ class CandidatePool:
         return (np.round(vol / d**3, _KEY_DECIMALS), np.round(area / d**2, _KEY_DECIMALS),
                 np.round(m0 / d, _KEY_DECIMALS), np.round(cen / d, _KEY_DECIMALS))
 
-    def make_candidates(self, cycles) -> list:
-        """Weigh cycles given as ``(edges, vertices)`` pairs, all of one length."""
-        if not cycles:
+    def make_candidates(self, edges, vertices) -> list:
+        """Weigh cycles of one length.
+
+        Parameters
+        ----------
+        edges, vertices : (n, L) int64 arrays
+            Edge ids and vertices of each cycle (any order within a row).
+        """
+        if len(edges) == 0:
             return []
-        vol, area, arclen, cen = self.measures([sorted(c[0]) for c in cycles])
+        E = np.sort(np.asarray(edges, dtype=np.int64), axis=1)  # (n, L)
+        vol, area, arclen, cen = self.measures(E)
+        L = E.shape[1]
         out = []
-        for j, (edges, verts) in enumerate(cycles):
-            edges = tuple(sorted(edges))
-            geo = (float(vol[j]), float(arclen[j]), *map(float, cen[j]), edges)
-            out.append(Candidate(edges, edge_mask(edges), len(edges), tuple(verts),
-                                 float(vol[j]), float(area[j]), geo))
+        for es, vs, v, a, ln, c in zip(map(tuple, E.tolist()), map(tuple, np.asarray(vertices)
+                                                                    .tolist()),
+                                       vol.tolist(), area.tolist(), arclen.tolist(),
+                                       cen.tolist()):
+            out.append(Candidate(es, L, vs, v, a, (v, ln, c[0], c[1], c[2], es)))
         return out
 
     def classify(self, candidates) -> None:
@@ -319,10 +350,45 @@ class CandidatePool:
                 c.separating = self.is_separating(c.vertices)
 
     # --- enumeration ------------------------------------------------------------
-    def raw_cycles_of_length(self, L: int) -> list:
-        """All simple cycles with ``L`` edges as ``(edges, vertices)``; ``None`` if over budget."""
+    def _use_numba(self) -> bool:
+        if self.engine == "python":
+            return False
+        if self.engine == "auto" and self.n_edges < NUMBA_MIN_EDGES:
+            return False
+        return _numba_kernel(required=self.engine == "numba") is not None
+
+    def raw_cycles_of_length(self, L: int):
+        """All simple cycles with ``L`` edges, each once.
+
+        Returns
+        -------
+        edges, vertices : (n, L) int64 arrays, or None
+            ``None`` when the work bound is hit.
+        """
         if L == 1:
-            return [((e,), (int(self._ends[e, 0]),)) for e in self.loops]
+            lp = np.array(self.loops, dtype=np.int64).reshape(-1, 1)
+            return lp, self._ends[lp[:, 0], :1].reshape(-1, 1)
+        if self._use_numba():
+            return self._raw_cycles_numba(L)
+        return self._raw_cycles_python(L)
+
+    def _raw_cycles_numba(self, L: int):
+        if self._csr is None:
+            nbr = [(x, y, e) for x in range(self.n_vertices) for y, e in self.adj[x]]
+            arr = np.array(nbr, dtype=np.int64).reshape(-1, 3)
+            indptr = np.searchsorted(arr[:, 0], np.arange(self.n_vertices + 1)).astype(np.int64)
+            self._csr = (indptr, np.ascontiguousarray(arr[:, 1]), np.ascontiguousarray(arr[:, 2]))
+        indptr, nbrs, eids = self._csr
+        kernel = _numba_kernel(required=True)
+        edges, verts, work, hit = kernel(L, indptr, nbrs, eids, self.n_vertices,
+                                         self.max_work, self.work)
+        self.work = int(work)
+        if hit:
+            self.work_bound_hit = True
+            return None
+        return edges, verts
+
+    def _raw_cycles_python(self, L: int):
         out = []
         adj = self.adj
         work = self.work
@@ -365,14 +431,15 @@ class CandidatePool:
                     self.work_bound_hit = True
                     return None
         self.work = work
-        return out
+        return (np.array([o[0] for o in out], dtype=np.int64).reshape(-1, L),
+                np.array([o[1] for o in out], dtype=np.int64).reshape(-1, L))
 
     def cycles_of_length(self, L: int):
         """Weighted candidates of length ``L``, or ``None`` when the work bound is hit."""
         raw = self.raw_cycles_of_length(L)
         if raw is None:
             return None
-        return self.make_candidates(raw)
+        return self.make_candidates(*raw)
 
     def horton_candidates(self, min_length: int = 1) -> list:
         """Horton (1987) cycles ``P(s, x) + (x, y) + P(y, s)`` from shortest-path trees.
@@ -421,8 +488,106 @@ class CandidatePool:
                     by_len.setdefault(len(edges), []).append((tuple(edges), tuple(set(verts))))
         out = []
         for L in sorted(by_len):
-            out.extend(self.make_candidates(by_len[L]))
+            out.extend(self.make_candidates(np.array([c[0] for c in by_len[L]]),
+                                            np.array([c[1] for c in by_len[L]])))
         return out
+
+
+_KERNEL = None
+
+
+def _numba_kernel(required: bool = False):
+    """The numba-compiled enumeration (compiled once, cached on disk); None without numba."""
+    global _KERNEL
+    if _KERNEL is not None:
+        return _KERNEL
+    try:
+        import numba
+    except ImportError:
+        if required:
+            from .errors import MissingDependencyError
+            raise MissingDependencyError("engine='numba' needs numba: pip install numba") \
+                from None
+        return None
+
+    @numba.njit(cache=True)
+    def kernel(L, indptr, nbrs, eids, nv, max_work, work):  # pragma: no cover - compiled
+        cap = 256
+        out_e = np.empty((cap, L), np.int64)
+        out_v = np.empty((cap, L), np.int64)
+        n = 0
+        dist = np.full(nv, -1, np.int64)
+        queue = np.empty(nv, np.int64)
+        onpath = np.zeros(nv, np.bool_)
+        pv = np.empty(L, np.int64)
+        pe = np.empty(L, np.int64)
+        ptr = np.empty(L, np.int64)
+        half = L // 2
+        for s in range(nv):
+            # breadth-first distances to s inside vertices >= s, up to L // 2
+            dist[s] = 0
+            queue[0] = s
+            head, tail = 0, 1
+            while head < tail:
+                x = queue[head]
+                head += 1
+                if dist[x] >= half:
+                    continue
+                for k in range(indptr[x], indptr[x + 1]):
+                    y = nbrs[k]
+                    if y > s and dist[y] < 0:
+                        dist[y] = dist[x] + 1
+                        queue[tail] = y
+                        tail += 1
+            # depth-first search of paths s -> ... -> back to s with L edges
+            pv[0] = s
+            ptr[0] = indptr[s]
+            onpath[s] = True
+            depth = 0
+            while depth >= 0:
+                x = pv[depth]
+                if ptr[depth] == indptr[x + 1]:
+                    onpath[x] = False
+                    depth -= 1
+                    continue
+                k = ptr[depth]
+                ptr[depth] += 1
+                z = nbrs[k]
+                ez = eids[k]
+                if depth == L - 1:
+                    if z == s and ez > pe[0]:
+                        if n == out_e.shape[0]:
+                            grow_e = np.empty((2 * n, L), np.int64)
+                            grow_v = np.empty((2 * n, L), np.int64)
+                            grow_e[:n] = out_e
+                            grow_v[:n] = out_v
+                            out_e, out_v = grow_e, grow_v
+                        for i in range(L - 1):
+                            out_e[n, i] = pe[i]
+                        out_e[n, L - 1] = ez
+                        for i in range(L):
+                            out_v[n, i] = pv[i]
+                        n += 1
+                    continue
+                if z <= s or onpath[z]:
+                    continue
+                dz = dist[z]
+                if dz < 0 or depth + 1 + dz > L:
+                    continue
+                work += 1
+                pe[depth] = ez
+                depth += 1
+                pv[depth] = z
+                ptr[depth] = indptr[z]
+                onpath[z] = True
+            for i in range(tail):
+                dist[queue[i]] = -1
+            if work > max_work:
+                return out_e[:n], out_v[:n], work, True
+        return out_e[:n], out_v[:n], work, False
+
+    _KERNEL = kernel
+    return _KERNEL
 
 
 def _validate(network, close, tie_break, max_cycle_length, max_work):
@@ -859,7 +1024,8 @@ def _auto_close(pool, patch_edges, max_length):
 
 
 def find_patches(network: CurveNetwork, *, close: str = "auto", tie_break: str = "pca",
-                 max_cycle_length=None, max_work: int = DEFAULT_MAX_WORK) -> PatchSet:
+                 max_cycle_length=None, max_work: int = DEFAULT_MAX_WORK,
+                 engine: str = "auto") -> PatchSet:
     """Find surface patches: minimum-weight GF(2) cycle basis plus closing patches.
 
     Parameters
@@ -883,6 +1049,8 @@ def find_patches(network: CurveNetwork, *, close: str = "auto", tie_break: str =
         Bound on enumeration steps (default ``DEFAULT_MAX_WORK``). When hit, the
         remaining candidates are Horton cycles (shortest-path cycles, which span
         the cycle space), and ``report["work_bound_hit"]`` is True.
+    engine : {"auto", "python", "numba"}
+        Cycle enumeration kernel (see :class:`CandidatePool`); same results.
 
     Returns
     -------
@@ -893,8 +1061,8 @@ def find_patches(network: CurveNetwork, *, close: str = "auto", tie_break: str =
         length: ``total`` enumerated, ``separating_examined``: separating ones
         that were independent when their turn came), ``max_length``, ``work``,
         ``work_bound_hit``, ``horton_candidates``, ``closing_added`` (edge
-        lists), ``tie_break``, ``close`` and ``timings`` (seconds per stage: ``setup``,
-        ``basis``, ``closing``; they add up to the total).
+        lists), ``tie_break``, ``close``, ``timings`` (``{"patches": seconds}``) and
+        ``patch_stages`` (seconds for ``setup``, ``basis``, ``closing``).
 
     Raises
     ------
@@ -934,7 +1102,7 @@ def find_patches(network: CurveNetwork, *, close: str = "auto", tie_break: str =
     """
     _validate(network, close, tie_break, max_cycle_length, max_work)
     t0 = time.perf_counter()
-    pool = CandidatePool(network, tie_break=tie_break, max_work=max_work)
+    pool = CandidatePool(network, tie_break=tie_break, max_work=max_work, engine=engine)
     t1 = time.perf_counter()
     basis, allc, info = greedy_basis(pool, max_cycle_length=max_cycle_length)
     pool.all_candidates = allc
@@ -958,8 +1126,10 @@ def find_patches(network: CurveNetwork, *, close: str = "auto", tie_break: str =
         "max_length": info["max_length"],
         "work": pool.work,
         "work_bound_hit": pool.work_bound_hit,
+        "engine": "numba" if pool._use_numba() else "python",
         "horton_candidates": info["horton_candidates"],
         "closing_added": [list(e) for e in added],
-        "timings": {"setup": t1 - t0, "basis": t2 - t1, "closing": t3 - t2},
+        "timings": {"patches": t3 - t0},
+        "patch_stages": {"setup": t1 - t0, "basis": t2 - t1, "closing": t3 - t2},
     }
     return PatchSet(network, patches, report)
