@@ -126,7 +126,7 @@ def fit_lsq(L, F, P0, constrained, targets, *, curve_weight: float | None = None
     rhs0 = reg * P0
     if curve_weight is None:
         k = len(constrained)
-        K = sp.bmat([[H, A.T], [A, -1e-14 * sp.identity(k)]], format="csc")
+        K = sp.bmat([[H, A.T], [A, sp.csr_matrix((k, k))]], format="csc")
         rhs = np.concatenate([rhs0, targets])
         sol = spla.splu(K).solve(rhs)
         return sol[:n]
