@@ -47,11 +47,13 @@ SEPARATING_EPS = 0.5
 TIE_BREAKS = ("pca", "aabb")
 #: Enumeration kernels of :class:`CandidatePool`.
 ENGINES = ("auto", "python", "numba")
-#: ``engine="auto"`` compiles the search with numba from this many curves on.
-NUMBA_MIN_EDGES = 150
+#: ``engine="auto"`` switches from the Python search to the numba kernel once
+#: this many search steps were spent (about half a second of Python): importing
+#: numba (about a second) costs more than shallow searches do.
+NUMBA_MIN_WORK = 500_000
 #: Default bound on search steps of the candidate enumeration (one step = one
-#: path extension); about a second of pure Python.
-DEFAULT_MAX_WORK = 1_000_000
+#: path extension): about 5 s of pure Python, a fraction of a second in numba.
+DEFAULT_MAX_WORK = 5_000_000
 #: Eigenvalues below this fraction of the largest are treated as zero, so planar
 #: cycles get exactly zero PCA volume despite round-off.
 _FLAT_RTOL = 1e-10
@@ -144,8 +146,8 @@ class CandidatePool:
         ``work_bound_hit`` is set and enumeration stops.
     engine : {"auto", "python", "numba"}
         Enumeration kernel: pure Python, or the same search compiled with numba
-        (cached on disk after the first compilation). ``"auto"`` uses numba for
-        networks with at least :data:`NUMBA_MIN_EDGES` curves when numba imports.
+        (cached on disk after the first compilation). ``"auto"`` starts in Python
+        and moves to numba (when it imports) after :data:`NUMBA_MIN_WORK` steps.
 
     Notes
     -----
@@ -181,6 +183,8 @@ class CandidatePool:
         self.loops = [e for e, (u, v) in enumerate(ends.tolist()) if u == v]
         self._dist = [None] * nv
         self._csr = None
+        #: "numba" once the numba kernel enumerated some length, else "python".
+        self.engine_used = "python"
         self._sep_cache: dict = {}
         self._comp = self._components()
         self.cycle_rank = ne - nv + int(self._comp.max() + 1 if nv else 0)
@@ -353,7 +357,7 @@ class CandidatePool:
     def _use_numba(self) -> bool:
         if self.engine == "python":
             return False
-        if self.engine == "auto" and self.n_edges < NUMBA_MIN_EDGES:
+        if self.engine == "auto" and self.work < NUMBA_MIN_WORK:
             return False
         return _numba_kernel(required=self.engine == "numba") is not None
 
@@ -369,6 +373,7 @@ class CandidatePool:
             lp = np.array(self.loops, dtype=np.int64).reshape(-1, 1)
             return lp, self._ends[lp[:, 0], :1].reshape(-1, 1)
         if self._use_numba():
+            self.engine_used = "numba"
             return self._raw_cycles_numba(L)
         return self._raw_cycles_python(L)
 
@@ -493,101 +498,17 @@ class CandidatePool:
         return out
 
 
-_KERNEL = None
-
-
 def _numba_kernel(required: bool = False):
-    """The numba-compiled enumeration (compiled once, cached on disk); None without numba."""
-    global _KERNEL
-    if _KERNEL is not None:
-        return _KERNEL
+    """The numba enumeration kernel, or None when numba is missing (and not required)."""
     try:
-        import numba
+        from ._cycle_kernel import enumerate_cycles
     except ImportError:
         if required:
             from .errors import MissingDependencyError
             raise MissingDependencyError("engine='numba' needs numba: pip install numba") \
                 from None
         return None
-
-    @numba.njit(cache=True)
-    def kernel(L, indptr, nbrs, eids, nv, max_work, work):  # pragma: no cover - compiled
-        cap = 256
-        out_e = np.empty((cap, L), np.int64)
-        out_v = np.empty((cap, L), np.int64)
-        n = 0
-        dist = np.full(nv, -1, np.int64)
-        queue = np.empty(nv, np.int64)
-        onpath = np.zeros(nv, np.bool_)
-        pv = np.empty(L, np.int64)
-        pe = np.empty(L, np.int64)
-        ptr = np.empty(L, np.int64)
-        half = L // 2
-        for s in range(nv):
-            # breadth-first distances to s inside vertices >= s, up to L // 2
-            dist[s] = 0
-            queue[0] = s
-            head, tail = 0, 1
-            while head < tail:
-                x = queue[head]
-                head += 1
-                if dist[x] >= half:
-                    continue
-                for k in range(indptr[x], indptr[x + 1]):
-                    y = nbrs[k]
-                    if y > s and dist[y] < 0:
-                        dist[y] = dist[x] + 1
-                        queue[tail] = y
-                        tail += 1
-            # depth-first search of paths s -> ... -> back to s with L edges
-            pv[0] = s
-            ptr[0] = indptr[s]
-            onpath[s] = True
-            depth = 0
-            while depth >= 0:
-                x = pv[depth]
-                if ptr[depth] == indptr[x + 1]:
-                    onpath[x] = False
-                    depth -= 1
-                    continue
-                k = ptr[depth]
-                ptr[depth] += 1
-                z = nbrs[k]
-                ez = eids[k]
-                if depth == L - 1:
-                    if z == s and ez > pe[0]:
-                        if n == out_e.shape[0]:
-                            grow_e = np.empty((2 * n, L), np.int64)
-                            grow_v = np.empty((2 * n, L), np.int64)
-                            grow_e[:n] = out_e
-                            grow_v[:n] = out_v
-                            out_e, out_v = grow_e, grow_v
-                        for i in range(L - 1):
-                            out_e[n, i] = pe[i]
-                        out_e[n, L - 1] = ez
-                        for i in range(L):
-                            out_v[n, i] = pv[i]
-                        n += 1
-                    continue
-                if z <= s or onpath[z]:
-                    continue
-                dz = dist[z]
-                if dz < 0 or depth + 1 + dz > L:
-                    continue
-                work += 1
-                pe[depth] = ez
-                depth += 1
-                pv[depth] = z
-                ptr[depth] = indptr[z]
-                onpath[z] = True
-            for i in range(tail):
-                dist[queue[i]] = -1
-            if work > max_work:
-                return out_e[:n], out_v[:n], work, True
-        return out_e[:n], out_v[:n], work, False
-
-    _KERNEL = kernel
-    return _KERNEL
+    return enumerate_cycles
 
 
 def _validate(network, close, tie_break, max_cycle_length, max_work):
@@ -1126,7 +1047,7 @@ def find_patches(network: CurveNetwork, *, close: str = "auto", tie_break: str =
         "max_length": info["max_length"],
         "work": pool.work,
         "work_bound_hit": pool.work_bound_hit,
-        "engine": "numba" if pool._use_numba() else "python",
+        "engine": pool.engine_used,
         "horton_candidates": info["horton_candidates"],
         "closing_added": [list(e) for e in added],
         "timings": {"patches": t3 - t0},
