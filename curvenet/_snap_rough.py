@@ -264,8 +264,12 @@ def _consolidate(st, samples, con, tol, h, opts, report):
         # the host's end (the end lies inside the overlap) is appended to the host,
         # however short; other pieces stay as strokes if at least `trim * tol` long.
         gp, gc = st.polys[guest], st.cums[guest]
-        hp, hc = st.polys[host], st.cums[host]
+        hp = st.polys[host]
+        head_in = h0 <= h                      # host ends lying inside the overlap
+        tail_in = h1 >= st.length(host) - h
+        head, tail = hp[0].copy(), hp[-1].copy()
         keep_min = opts.trim * tol
+        before, after = [], []
         for lo, hi, attach_at_start in ((0.0, g0, False), (g1, gc[-1], True)):
             if hi - lo <= 0.5 * h:
                 continue
@@ -273,16 +277,14 @@ def _consolidate(st, samples, con, tol, h, opts, report):
             if not attach_at_start:
                 piece = piece[::-1]  # now starts at the overlap
             pa = piece[0]
-            if h1 >= hc[-1] - h and np.linalg.norm(hp[-1] - pa) <= 2.0 * tol:
-                hp = np.vstack([hp, piece])
-                st.set(host, hp)
-                hc = st.cums[host]
-            elif h0 <= h and np.linalg.norm(hp[0] - pa) <= 2.0 * tol:
-                hp = np.vstack([piece[::-1], hp])
-                st.set(host, hp)
-                hc = st.cums[host]
+            if tail_in and not after and np.linalg.norm(tail - pa) <= 2.0 * tol:
+                after = [piece]
+            elif head_in and not before and np.linalg.norm(head - pa) <= 2.0 * tol:
+                before = [piece[::-1]]
             elif hi - lo >= keep_min:
                 new.append((piece, st.srcs[guest], st.labels[guest]))
+        if before or after:
+            st.set(host, np.vstack(before + [hp] + after))
         removed.add(guest)
         report["overdraw_consolidations"] += 1
     if not busy:

@@ -77,6 +77,11 @@ __all__ = ["SnapOptions", "DEFAULT_SNAP_TOL", "snap", "prune_dangling", "danglin
 #: 2.1% apart (see tests/curvenet/test_snap.py for the measured success rate).
 DEFAULT_SNAP_TOL = 0.025
 
+#: Counters present in every ``network.report`` (see :func:`snap`).
+_COUNTERS = ("crossings", "t_junctions", "gap_merges", "closed_strokes", "trimmed_overshoots",
+             "overdraw_consolidations", "corners", "dissolved_joins", "slivers_merged",
+             "strokes_dropped_short")
+
 _EXACT_EPS = 1e-9   # coincidence tolerance of exact mode, fraction of the diagonal
 _MAX_SAMPLES = 2_000_000
 
@@ -201,9 +206,9 @@ def _snap_exact(strokes, src, labels, diag):
     offs = np.cumsum([0] + [len(s) for s in strokes])
     polys = [ids[offs[k]:offs[k + 1]] for k in range(len(strokes))]
     net = _indexed_network(verts, polys, labels, src)
-    net.report = {"mode": "exact", "junctions": int(sum(
-        1 for d in np.bincount(net.endpoints.ravel(), minlength=net.number_of_vertices)
-        if d >= 3))}
+    net.report = dict.fromkeys(_COUNTERS, 0)
+    net.report.update(mode="exact", warnings=[],
+                      closed_strokes=sum(1 for e in net.edges if e.u == e.v))
     return net
 
 
