@@ -59,6 +59,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--interactive", action="store_true",
                    help="review patches: delete, accept/reject suggestions, undo, save")
     s.add_argument("--preview", metavar="PNG", help="write a picture of the patches")
+    s.add_argument("--up", choices=("x", "y", "z"), default="z", help="up axis of the preview")
 
     s = sub.add_parser("surface", help="surface a sketch, network or patch set")
     s.add_argument("inputs", nargs="+", metavar="INPUT")
@@ -81,6 +82,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--device", default="cpu", help="cpu or cuda (neural route)")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--preview", metavar="PNG", help="write a picture of the result")
+    s.add_argument("--up", choices=("x", "y", "z"), default="z", help="up axis of the preview")
     s.add_argument("--explain", action="store_true", help="say which route was taken and why")
     s.add_argument("--no-progress", action="store_true", help="hide progress bars")
 
@@ -123,7 +125,8 @@ def _cmd_patches(args) -> int:
           f"({sum(t.values()):.2f} s)")
     if args.preview:
         from .preview import render_preview
-        render_preview(args.preview, network=ps.network, patches=ps, title=Path(args.input).name)
+        render_preview(args.preview, network=ps.network, patches=ps, title=Path(args.input).name,
+                       up=args.up)
     return 0
 
 
@@ -143,9 +146,8 @@ def _surface_one(inp: str, out: str, args) -> dict:
         if args.preview:
             from .preview import render_preview
             prev = args.preview if args.output else str(Path(out).with_suffix(".png"))
-            render_preview(prev, strokes=res.sketch.strokes if res.sketch else None,
-                           network=res.network, mesh=res.mesh, title=f"{Path(inp).name}: "
-                           f"{res.method}")
+            render_preview(prev, strokes=res.sketch, network=res.network, mesh=res.mesh,
+                           title=f"{Path(inp).name}: {res.method}", up=args.up)
         return {"input": inp, "output": out, "status": "ok", "method": res.method,
                 "faces": len(res.mesh.faces), "seconds": time.perf_counter() - t0,
                 "why": res.diagnostics.get("decision", "")}
@@ -209,24 +211,24 @@ def _print_row(row: dict, explain: bool) -> None:
 
 
 def _cmd_eval(args) -> int:
-    from .evaluate import evaluate_mesh, format_report, load_mesh, stroke_distance
+    from .evaluate import evaluate_mesh, format_report, stroke_distance
     from .pipeline import MESH_FORMATS
     ref = Path(args.reference)
-    if ref.suffix.lower() in MESH_FORMATS and ref.suffix.lower() != ".obj" or _is_mesh_obj(ref):
+    is_mesh = ref.suffix.lower() in MESH_FORMATS and (ref.suffix.lower() != ".obj"
+                                                       or _is_mesh_obj(ref))
+    if is_mesh:
         metrics = evaluate_mesh(args.mesh, args.reference, n_samples=args.samples,
                                 threshold=args.threshold)
     else:
         from .io import read_sketch
-        sketch = read_sketch(ref)
-        metrics = stroke_distance(load_mesh(args.mesh), sketch.select(("boundary",
-                                                                       "crease")).strokes)
+        metrics = stroke_distance(args.mesh, read_sketch(ref))
     print(json.dumps(metrics, indent=2) if args.json else format_report(metrics))
     return 0
 
 
 def _is_mesh_obj(path: Path) -> bool:
     """An OBJ with ``f`` lines is a mesh; one with only ``l`` lines is a sketch."""
-    if path.suffix.lower() != ".obj" or not path.is_file():
+    if not path.is_file():
         return False
     with open(path, "rb") as fh:
         for raw in fh:

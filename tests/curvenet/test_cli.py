@@ -1,0 +1,108 @@
+"""The curvenet command, invoked as a user would: real files in, files and exit codes out."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import trimesh
+
+from curvenet import shapes
+from curvenet.cli import main
+from curvenet.io import write_sketch
+
+
+def run(*argv):
+    """Run the CLI in a subprocess (the real entry point, real stdio)."""
+    return subprocess.run([sys.executable, "-m", "curvenet.cli", *map(str, argv)],
+                          capture_output=True, text=True, timeout=600)
+
+
+@pytest.fixture
+def box_obj(tmp_path):
+    path = tmp_path / "box.obj"
+    write_sketch(path, shapes.box().sketch())
+    return path
+
+
+def test_snap_patches_surface_eval_chain(tmp_path, box_obj):
+    net = tmp_path / "net.json"
+    r = run("snap", box_obj, "-o", net)
+    assert r.returncode == 0, r.stderr
+    data = json.loads(net.read_text())
+    assert data["format"] == "curvenet.network" and len(data["edges"]) == 12
+
+    pat = tmp_path / "patches.json"
+    r = run("patches", net, "-o", pat)
+    assert r.returncode == 0, r.stderr
+    data = json.loads(pat.read_text())
+    assert len(data["patches"]) == 6
+
+    mesh_path = tmp_path / "box_out.ply"
+    r = run("surface", box_obj, "--patches", pat, "-o", mesh_path, "--method", "classical",
+            "--no-progress")
+    assert r.returncode == 0, r.stderr
+    mesh = trimesh.load(mesh_path, force="mesh")
+    assert mesh.is_watertight
+    np.testing.assert_allclose(mesh.bounds, [[0, 0, 0], [1, 1, 1]], atol=2e-3)
+
+    ref = tmp_path / "ref.off"
+    shapes.box().reference_mesh().export(ref)
+    r = run("eval", mesh_path, ref, "--json", "--samples", "20000")
+    assert r.returncode == 0, r.stderr
+    metrics = json.loads(r.stdout)
+    assert {"chamfer", "hausdorff", "normal_error_deg", "fscore"} <= set(metrics)
+    assert metrics["fscore"] > 0.99
+    # nothing half-written or temporary is left behind
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        ["box.obj", "net.json", "patches.json", "box_out.ply", "ref.off"])
+
+
+@pytest.mark.parametrize("content, needle", [
+    ("", "empty"),
+    ("v 0 0 0\nv nan 1 0\nl 1 2\n", ":2"),
+    ("v 0 0 0\nl 1\n", ""),
+    ("v 0 0 0\nv 1 0 0\nl 1 7\n", ":3"),
+])
+def test_bad_sketch_gives_one_line_and_exit_2(tmp_path, content, needle):
+    bad = tmp_path / "bad.obj"
+    bad.write_text(content)
+    out = tmp_path / "out.obj"
+    r = run("surface", bad, "-o", out, "--no-progress")
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "bad.obj" in lines[0] and needle in lines[0]
+    assert "Traceback" not in r.stderr
+    assert not out.exists()
+
+
+def test_missing_file_and_unknown_output_format(tmp_path, box_obj):
+    r = run("patches", tmp_path / "nope.obj", "-o", tmp_path / "p.json")
+    assert r.returncode == 2 and "nope.obj" in r.stderr
+    r = run("surface", box_obj, "-o", tmp_path / "mesh.xyz")
+    assert r.returncode == 2 and "mesh.xyz" in r.stderr
+    r = run("snap", box_obj, "-o", tmp_path / "n.json", "--snap-tol", "7")
+    assert r.returncode == 2 and "snap-tol" in r.stderr
+
+
+def test_batch_reports_each_file_and_survives_a_bad_one(tmp_path, box_obj, capsys):
+    bad = tmp_path / "broken.obj"
+    bad.write_text("this is not a sketch\n")
+    code = main(["surface", str(box_obj), str(bad), "--out-dir", str(tmp_path / "out"),
+                 "--method", "classical", "--format", "ply"])
+    out = capsys.readouterr().out
+    assert code == 2
+    assert "ok" in out and "FAILED" in out and "1 of 2 surfaced" in out
+    assert (tmp_path / "out" / "box.ply").is_file()
+    assert not (tmp_path / "out" / "broken.ply").exists()
+
+
+def test_import_curvenet_and_patches_do_not_import_torch(box_obj, tmp_path):
+    code = ("import sys, curvenet; from curvenet.cli import main; "
+            f"main(['patches', {str(box_obj)!r}, '-o', {str(tmp_path / 'p.json')!r}]); "
+            "sys.exit(3 if 'torch' in sys.modules else 0)")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
