@@ -37,7 +37,8 @@ from .network import CurveNetwork
 from .patchset import Patch, PatchSet
 
 __all__ = ["find_patches", "cycle_to_loop", "orient_patches", "closing_suggestions",
-           "Candidate", "CandidatePool", "SEPARATING_EPS", "TIE_BREAKS", "DEFAULT_MAX_WORK"]
+           "greedy_basis", "Candidate", "CandidatePool", "SEPARATING_EPS", "TIE_BREAKS",
+           "ENGINES", "DEFAULT_MAX_WORK", "NUMBA_MIN_WORK"]
 
 #: ``eps`` of ``k = #edges + (2 + eps) s`` (Sec. 4.2). Any value in (0, 1) gives the
 #: same order; it only places separating cycles of length ``i - 2`` after the
@@ -182,6 +183,8 @@ class CandidatePool:
         self.nbrs = [sorted({y for y, _ in lst}) for lst in self.adj]
         self.loops = [e for e, (u, v) in enumerate(ends.tolist()) if u == v]
         self._dist = [None] * nv
+        #: Candidates offered to closing / replacement suggestions (set by the caller).
+        self.all_candidates: list = []
         self._csr = None
         #: "numba" once the numba kernel enumerated some length, else "python".
         self.engine_used = "python"
@@ -704,10 +707,11 @@ def orient_patches(network: CurveNetwork, patches) -> list:
     direction, so adjacent patches traverse it in opposite directions where the
     surface is orientable (non-manifold edges, used by three or more patches,
     impose nothing; on a non-orientable surface the first orientation found
-    wins). Each group of patches connected this way is then flipped as a whole
-    if its fan-triangulated signed volume is negative, so closed surfaces come
-    out with outward normals (right-hand rule); open ones keep the orientation
-    of their first patch.
+    wins). Each group of patches connected this way that is closed (every edge
+    used twice within it) is then flipped as a whole if its fan-triangulated
+    signed volume is negative, so closed surfaces come out with outward normals
+    (right-hand rule); open ones keep the orientation of their first patch as
+    :func:`cycle_to_loop` walks it.
     """
     edge_sets = [p.edges if isinstance(p, Patch) else tuple(p) for p in patches]
     loops = [cycle_to_loop(network, es) for es in edge_sets]
@@ -738,7 +742,12 @@ def orient_patches(network: CurveNetwork, patches) -> list:
                 done[j] = True
                 group.append(j)
                 q.append(j)
-        if _signed_volume(network, [loops[i] for i in group]) < 0:
+        uses: dict = {}
+        for i in group:
+            for e in edge_sets[i]:
+                uses[e] = uses.get(e, 0) + 1
+        closed = all(n == 2 for n in uses.values())
+        if closed and _signed_volume(network, [loops[i] for i in group]) < 0:
             for i in group:
                 loops[i] = [(x, not f) for x, f in reversed(loops[i])]
     return loops

@@ -384,3 +384,14 @@ def test_runs_on_public_networks(data_dir):
         assert len(auto) == net.cycle_rank()
         for p in ps.patches:
             cycle_to_loop(net, p.edges)
+
+
+def test_tree_and_empty_networks_have_no_patches():
+    empty = CurveNetwork(np.zeros((0, 3)))
+    ps = find_patches(empty)
+    assert ps.patches == [] and ps.report["rank"] == 0 and ps.report["full_rank"]
+    tree = CurveNetwork(np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]]))
+    tree.add_edge(0, 1, [[0, 0, 0], [1, 0, 0]])
+    tree.add_edge(0, 2, [[0, 0, 0], [0, 1, 0]])
+    ps = find_patches(tree)
+    assert ps.patches == [] and ps.report["rank"] == 0
