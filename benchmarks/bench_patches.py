@@ -6,7 +6,9 @@ Run ``python benchmarks/bench_patches.py [--quick] [--no-data]``. Prints two tab
    ``find_patches`` time (median of repeats), whether it returned the true
    faces, and ``networkx.minimum_cycle_basis`` on the same graph in the same
    run (simple graph: grid boxes have no parallel curves), with the ratio;
-2. the networks in ``../shared/data/networks/*/*.obj`` (or ``$CURVENET_DATA``):
+2. sketch file (OBJ, one stroke per curve) to ``PATCHES.json`` in process:
+   read, snap, find patches, write;
+3. the networks in ``../shared/data/networks/*/*.obj`` (or ``$CURVENET_DATA``):
    curves, rank, patches found (auto + closing), longest candidate length,
    whether the work bound was hit, and time.
 
@@ -58,6 +60,32 @@ def bench_grid_boxes(sizes, repeats, nx_limit):
               f"{len(shape.faces):>7}{t_ours:>9.3f}{str(exact):>7}{t_nx:>10.2f}{ratio:>9.0f}")
 
 
+def bench_sketch_to_file(sizes, repeats):
+    """Sketch OBJ -> PATCHES.json in process (read, snap, find patches, write)."""
+    import tempfile
+
+    from curvenet.io import write_sketch
+    from curvenet.patchset import save_patchset
+    from curvenet.pipeline import patches
+
+    print(f"\n{'sketch -> PATCHES.json':<24}{'curves':>7}{'patches':>8}{'total s':>9}"
+          f"{'find s':>8}")
+    with tempfile.TemporaryDirectory() as tmp:
+        for n in sizes:
+            shape = grid_box(n)
+            src, dst = Path(tmp) / f"gb{n}.obj", Path(tmp) / f"gb{n}.json"
+            write_sketch(src, shape.sketch())
+
+            def run(src=src, dst=dst):
+                ps = patches(src)
+                save_patchset(dst, ps)
+                return ps
+
+            t, ps = _time(run, repeats)
+            print(f"{'grid_box(' + str(n) + ')':<24}{ps.network.number_of_edges:>7}"
+                  f"{len(ps.patches):>8}{t:>9.3f}{ps.report['timings']['patches']:>8.3f}")
+
+
 def bench_data(repeats):
     from curvenet.io import read_network_obj
 
@@ -86,8 +114,10 @@ def main(argv=None):
     args = ap.parse_args(argv)
     if args.quick:
         bench_grid_boxes([2, 4], 1, nx_limit=200)
+        bench_sketch_to_file([4], 1)
     else:
         bench_grid_boxes([2, 4, 6, 9], 5, nx_limit=450)
+        bench_sketch_to_file([4, 9], 3)
     if not args.no_data:
         bench_data(1 if args.quick else 3)
     return 0
