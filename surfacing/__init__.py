@@ -14,7 +14,7 @@ from .coons import coons_eval, coons_grid
 from .controlmesh import ControlMesh, build_control_mesh
 from .limit import limit_matrix, tangent_matrices
 from .sides import group_sides
-from .soapfilm import soapfilm_patch
+from .soap import soapfilm_patch
 
 __all__ = [
     "DEFAULT_RESOLUTION", "DEFAULT_SUBDIV", "SurfaceResult", "surface_loops", "soapfilm_loops",

@@ -20,7 +20,7 @@ from .fit import FAIRNESS, LAMBDA, fairness_matrix, fit_iterative, fit_lsq, vari
 from .limit import limit_matrix, tangent_matrices
 from .polyline import point_polyline_distance
 from .sides import DEFAULT_STRAIGHT_ANGLE
-from .soapfilm import soapfilm_mesh
+from .soap import soapfilm_mesh
 
 __all__ = ["SurfaceResult", "surface_loops", "soapfilm_loops", "DEFAULT_RESOLUTION",
            "DEFAULT_SUBDIV", "DEFAULT_TOL"]
@@ -94,7 +94,9 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
         Degrees; shared curves whose patches meet at a larger dihedral angle become
         creases too. None: labelled creases only.
     resolution : int
-        Control-polygon segments per curve (even, >= 2).
+        Control-polygon segments per curve piece (>= 2; odd values are rounded up to
+        even). Long or winding curves get several pieces (see
+        :func:`surfacing.controlmesh.curve_pieces`).
     subdiv : int
         Catmull-Clark levels for the output mesh (>= 0).
     fit : {"lsq", "iterative"}
@@ -236,7 +238,7 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
         "n_control_vertices": int(n),
         "n_faces": int(len(faces)),
         "patch_kinds": kinds,
-        "resolution": int(resolution),
+        "resolution": int(resolution) + int(resolution) % 2,
         "subdiv": subdiv,
     }
     return SurfaceResult(Vout, faces, face_patch, report, new_curves, P, cm.quads)

@@ -294,7 +294,8 @@ def build_control_mesh(curves, loops, resolution: int = 4, *,
     loops : list of list of (int, bool)
         Each loop: (curve index, traversed forward) in traversal order.
     resolution : int
-        ``N``, control-polygon segments per curve; even, >= 2.
+        ``N``, control-polygon segments per curve (per piece), >= 2; an odd value is
+        rounded up to the next even one (the centre split halves pieces).
     straight_angle : float
         Degrees; curves turning less at a junction belong to one side.
     orient : bool
@@ -312,12 +313,14 @@ def build_control_mesh(curves, loops, resolution: int = 4, *,
     ----------
     Orbay & Kara 2011, Sec. 4.2 (Fig. 6).
     """
-    N = int(resolution)
-    if N < 2 or N % 2:
-        raise ValueError(f"resolution: expected an even integer >= 2, got {resolution!r}")
+    if isinstance(resolution, bool) or int(resolution) != resolution or resolution < 2:
+        raise ValueError(f"resolution: expected an integer >= 2, got {resolution!r}")
+    N = int(resolution) + int(resolution) % 2       # the centre split halves pieces
     curves, loops = _validate(curves, loops)
     if not curves:
         raise ValueError("curves: empty")
+    if not loops:
+        raise ValueError("loops: empty (nothing to surface)")
     allpts = np.concatenate(curves)
     diag = float(np.linalg.norm(allpts.max(0) - allpts.min(0)))
     if orient:

@@ -92,7 +92,8 @@ def variation_matrix(F) -> sp.csr_matrix:
     return (D @ F).tocsr()
 
 
-def fit_lsq(L, F, P0, constrained, targets, *, curve_weight: float | None = None):
+def fit_lsq(L, F, P0, constrained, targets, *, curve_weight: float | None = None,
+            extra=None):
     """Direct sparse fit of the limit surface to the curve samples.
 
     Parameters
@@ -110,8 +111,11 @@ def fit_lsq(L, F, P0, constrained, targets, *, curve_weight: float | None = None
         Curve samples they must interpolate (limit positions).
     curve_weight : float or None
         None: exact interpolation (KKT). Otherwise the penalty weight of
-        ``|| L[c] P - q ||^2`` against the fairness (relative to the mean squared
-        control-edge length), for the smoothing mode of Sec. 4.3.3.
+        ``|| L[c] P - q ||^2`` against the fairness, for the smoothing mode of
+        Sec. 4.3.3.
+    extra : (A2 (k2, n) sparse, q2 (k2, 3), w2 float), optional
+        Soft rows added to the energy as ``w2 || A2 P - q2 ||^2`` (e.g. limit points
+        of a finer level along the curves, between the interpolated samples).
 
     Returns
     -------
@@ -124,6 +128,10 @@ def fit_lsq(L, F, P0, constrained, targets, *, curve_weight: float | None = None
     reg = _TIKHONOV * max(H.diagonal().mean(), 1e-300)
     H = H + reg * sp.identity(n, format="csr")
     rhs0 = reg * P0
+    if extra is not None:
+        A2, q2, w2 = extra
+        H = (H + w2 * (A2.T @ A2)).tocsr()
+        rhs0 = rhs0 + w2 * (A2.T @ np.asarray(q2, dtype=np.float64))
     if curve_weight is None:
         k = len(constrained)
         K = sp.bmat([[H, A.T], [A, sp.csr_matrix((k, k))]], format="csc")

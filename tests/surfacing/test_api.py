@@ -124,7 +124,7 @@ def test_face_patch_and_report_fields():
 
 
 @pytest.mark.parametrize("kw, match", [({"fit": "magic"}, "fit"), ({"subdiv": -1}, "subdiv"),
-                                       ({"resolution": 3}, "resolution"),
+                                       ({"resolution": 1}, "resolution"),
                                        ({"fairness": "x"}, "fairness"), ({"tol": 0}, "tol")])
 def test_bad_options(kw, match):
     s = shapes.box()

@@ -136,11 +136,23 @@ def test_adaptive_pieces_follow_quad_strips():
     assert cm.patch_kind == ["grid"]
 
 
-@pytest.mark.parametrize("bad", [0, 3, -2])
+@pytest.mark.parametrize("bad", [0, 1, -2, 2.5])
 def test_resolution_validated(bad):
     s, curves = _net("box")
     with pytest.raises(ValueError, match="resolution"):
         build_control_mesh(curves, s.faces, bad)
+
+
+def test_odd_resolution_rounds_up():
+    s, curves = _net("box")
+    cm = build_control_mesh(curves, s.faces, 3)
+    assert all(len(v) == 5 for v in cm.curve_vids)
+
+
+def test_empty_loops_rejected():
+    s, curves = _net("box")
+    with pytest.raises(ValueError, match="loops"):
+        build_control_mesh(curves, [], 4)
 
 
 def test_bad_loops_rejected():

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from surfacing.polyline import arc_length_params
-from surfacing.soapfilm import _cotan_laplacian, disk_triangulation, soapfilm_mesh, soapfilm_patch
+from surfacing.soap import _cotan_laplacian, disk_triangulation, soapfilm_mesh, soapfilm_patch
 
 
 def test_disk_triangulation_border_and_orientation():
