@@ -1,0 +1,98 @@
+"""Loss terms of the flow-aligned variational formulation (Zhang et al. 2025, Eq. 13).
+
+Each term is the Monte-Carlo mean of its integrand over the matching sample
+set (Sec. 5.1): alignment and data on stroke samples, smoothness and Eikonal on
+iso-surface samples, curl on volume samples. Weights are named arguments of
+:class:`LossWeights` with the paper's values.
+
+References
+----------
+Zhang, Wang, Bessmeltsev 2025: Eq. 4 (alignment), 5 (smoothness), 7 (data),
+the Eikonal term of Sec. 4.3, 12 (curl), 13 (weights).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import torch
+
+from .geometry import alignment_cos4, covariant_tv, curl, second_fundamental_form, tangent_frame
+
+__all__ = ["LossWeights", "alignment_loss", "smoothness_loss", "smoothness_loss_autograd",
+           "data_loss", "eikonal_loss", "curl_loss"]
+
+
+@dataclass(frozen=True)
+class LossWeights:
+    """Weights of Eq. 13 (Sec. 4.4.3: 1, 0.01, 30, 7, 7 "for all the results in the paper")."""
+
+    w_align: float = 1.0
+    w_smooth: float = 0.01
+    w_data: float = 30.0
+    w_eik: float = 7.0
+    w_curl: float = 7.0
+
+
+def alignment_loss(g, G, tangents):
+    """Eq. 4: mean of ``(cos 4 alpha - 1)^2`` over stroke samples.
+
+    Parameters
+    ----------
+    g : (N, 3), G : (N, 3, 3), tangents : (N, 3)
+
+    Returns
+    -------
+    scalar tensor in ``[0, 4]``; samples with no defined principal direction
+    (umbilic or tangent normal to the surface) contribute 0.
+    """
+    cos4, _ = alignment_cos4(g, G, tangents)
+    return ((cos4 - 1.0) ** 2).mean()
+
+
+def smoothness_loss(g, G, H):
+    """Eq. 5: mean over surface samples of ``||nabla_S II||_F`` (covariant TV)."""
+    return covariant_tv(g, G, H).mean()
+
+
+def smoothness_loss_autograd(net, x, *, eps: float = 1e-12):
+    """Eq. 5 by double backward instead of the closed-form jet (same value).
+
+    ``II`` is built from ``net.jet(x, order=1)`` and differentiated with
+    respect to ``x`` by autograd (6 distinct components, ``create_graph``), then
+    projected as in :func:`neural.geometry.covariant_tv`. Slower; kept as the
+    reference the jet version is tested against and for ``smooth_mode="autograd"``.
+    """
+    x = x.detach().requires_grad_(True)
+    g, G = net.jet(x, order=1)
+    II = second_fundamental_form(g, G)
+    grads = {}
+    for i in range(3):
+        for j in range(i, 3):
+            grads[i, j] = torch.autograd.grad(II[:, i, j].sum(), x, create_graph=True)[0]
+    D = torch.stack([torch.stack([grads[min(i, j), max(i, j)] for j in range(3)], 1)
+                     for i in range(3)], 1)                       # (N, 3, 3, 3): d II_ij / d x_k
+    n = g / g.norm(dim=-1, keepdim=True).clamp(min=1e-12)
+    P = torch.eye(3, dtype=g.dtype, device=g.device) - n.unsqueeze(-1) * n.unsqueeze(-2)
+    t1, t2 = tangent_frame(n)
+    total = 0.0
+    for t in (t1, t2):
+        Dt = P @ torch.einsum("nijk,nk->nij", D, t) @ P
+        total = total + (Dt * Dt).sum((-1, -2))
+    return torch.sqrt(total + eps).mean()
+
+
+def data_loss(f_strokes):
+    """Eq. 7: mean of ``|f|`` at stroke samples (f normalised by Eq. 11)."""
+    return f_strokes.abs().mean()
+
+
+def eikonal_loss(g, sigma: float = 0.5):
+    """Sec. 4.3: ``1/2 mean (|g| - sigma)^2`` on surface samples (sigma = 0.5)."""
+    return 0.5 * ((g.norm(dim=-1) - sigma) ** 2).mean()
+
+
+def curl_loss(G):
+    """Eq. 12: mean of ``|curl g|^2`` over volume samples."""
+    c = curl(G)
+    return (c * c).sum(-1).mean()
