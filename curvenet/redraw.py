@@ -185,13 +185,17 @@ def match_networks(reference: CurveNetwork, result: CurveNetwork, *, tol: float 
     if not ref or not out:
         return {"same_counts": same, "max_distance": float("inf"), "matched": False,
                 "ok": False}
-    trees = [cKDTree(o) for o in out]
+    owner = np.repeat(np.arange(len(out)), samples)
+    big = cKDTree(np.concatenate(out))
     best, worst = [], 0.0
     for r in ref:
+        # candidates: the result curves that own the nearest samples of this curve
+        _, nn = big.query(r)
+        cand = np.unique(owner[nn])
         rt = cKDTree(r)
-        d = [max(t.query(r)[0].max(), rt.query(o)[0].max()) for t, o in zip(trees, out)]
+        d = [max(cKDTree(out[c]).query(r)[0].max(), rt.query(out[c])[0].max()) for c in cand]
         j = int(np.argmin(d))
-        best.append(j)
+        best.append(int(cand[j]))
         worst = max(worst, d[j] / diag)
     matched = len(set(best)) == len(best)
     return {"same_counts": bool(same), "max_distance": float(worst), "matched": matched,
