@@ -1,0 +1,64 @@
+"""curvenet.surface: the auto route decision, the classical and neural routes, errors."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import curvenet
+from curvenet import Sketch, shapes
+from curvenet.evaluate import evaluate_mesh
+from curvenet.pipeline import AUTO_MIN_COVERAGE
+
+#: a neural budget small enough for CI; the decision, not the quality, is under test here
+TINY = dict(res=32, width=32, hidden_layers=2, n_stroke=500, n_surface=400, n_volume=400,
+            init_steps=10, steps=15)
+
+
+def test_auto_takes_classical_on_a_clean_network():
+    s = shapes.latlong_sphere()
+    res = curvenet.surface(s.sketch())
+    assert res.method == "classical"
+    assert res.diagnostics["decision"].startswith("classical")
+    assert res.diagnostics["coverage"] >= AUTO_MIN_COVERAGE
+    assert res.diagnostics["unused_edges"] == []
+    m = evaluate_mesh(res.mesh, s.reference_mesh(), n_samples=20_000)
+    assert m["fscore"] > 0.99
+    assert set(res.timings) >= {"snap", "patches", "classical"}
+
+
+def test_auto_takes_neural_on_disjoint_strokes():
+    # parallel circles that never touch: no cycles, so no patches
+    t = np.linspace(0, 2 * np.pi, 40, endpoint=False)
+    strokes = [np.c_[np.cos(t[:-3]) * r, np.sin(t[:-3]) * r, np.full(37, z)]
+               for z, r in [(-0.6, 0.8), (0.0, 1.0), (0.6, 0.8)]]
+    res = curvenet.surface(Sketch(strokes), neural_options=TINY)
+    assert res.diagnostics["decision"].startswith("neural")
+    assert res.method == "neural"
+    assert len(res.mesh.faces) > 0 and np.isfinite(res.mesh.vertices).all()
+
+
+def test_patches_api_and_dangling_strokes_are_reported():
+    s = shapes.box()
+    sk = s.sketch()
+    # a dangling detail stroke hanging off a corner
+    sk = Sketch(sk.strokes + [np.array([[1, 1, 1], [1.2, 1.3, 1.4], [1.3, 1.6, 1.5]])],
+                sk.labels + ["boundary"])
+    res = curvenet.surface(sk, method="classical")
+    assert len(res.patchset.patches) == 6
+    assert len(res.diagnostics["unused_edges"]) == 1
+    assert res.mesh.is_watertight
+
+
+def test_bad_parameters_raise_curvenet_errors():
+    sk = shapes.box().sketch()
+    with pytest.raises(curvenet.InvalidParameterError, match="method"):
+        curvenet.surface(sk, method="magic")
+    with pytest.raises(curvenet.InvalidParameterError, match="quality"):
+        curvenet.surface(sk, quality="ultra")
+    with pytest.raises(curvenet.InvalidParameterError, match="crease_angle"):
+        curvenet.surface(sk, crease_angle=-3)
+    with pytest.raises(curvenet.CurvenetError, match="no patches"):
+        curvenet.surface(Sketch([[[0, 0, 0], [1, 0, 0]]]), method="classical")
+    with pytest.raises(curvenet.SketchFormatError, match="no such file"):
+        curvenet.surface("/nonexistent/sketch.obj")
