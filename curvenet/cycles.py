@@ -972,7 +972,9 @@ def find_patches(network: CurveNetwork, *, close: str = "auto", tie_break: str =
         PCA is the default because real sketches are not drawn aligned with the
         coordinate axes, and an AABB volume changes under rotation (a tilted
         planar face gets a positive AABB volume); PCA volume is rotation
-        invariant and zero for every planar cycle.
+        invariant and zero for every planar cycle. On the 29 public networks a
+        random rotation changed 29 patches with ``"aabb"`` and 4 with ``"pca"``
+        (exact geometric ties in symmetric models).
     max_cycle_length : int, optional
         Longest candidate cycle; the basis may stay incomplete (reported).
     max_work : int
@@ -1017,6 +1019,11 @@ def find_patches(network: CurveNetwork, *, close: str = "auto", tie_break: str =
     two patches that continue smoothly (Newell normals within 30 degrees), so
     the crease is explained only by a third patch (the face shared by two
     stacked boxes). Unlabelled sketches never get walls.
+
+    Limitation (as in the paper): on a surface of genus ``g`` every cycle basis
+    holds ``2 g`` cycles that bound no face, and planar handle rings beat
+    curved faces on the volume tie-break, so a torus does not come out as its
+    faces.
 
     References
     ----------
