@@ -16,7 +16,8 @@ from .catmull_clark import edge_index, subdivision_step
 from .controlmesh import build_control_mesh
 from .creases import DEFAULT_CREASE_ANGLE, sharp_structure
 from .curveupdate import fit_cubic_curve
-from .fit import FAIRNESS, LAMBDA, fairness_matrix, fit_iterative, fit_lsq, variation_matrix
+from .fit import (FAIRNESS, LAMBDA, VSPRING_STEP, fairness_matrix, fit_iterative, fit_lsq,
+                  variation_matrix)
 from .limit import limit_matrix, tangent_matrices
 from .polyline import point_polyline_distance
 from .sides import DEFAULT_STRAIGHT_ANGLE
@@ -77,7 +78,8 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
                   straight_angle: float = DEFAULT_STRAIGHT_ANGLE, tol: float = DEFAULT_TOL,
                   max_iter: int = 500, lam: float = LAMBDA,
                   curve_weight: float | None = None,
-                  fairness: str = "variation") -> SurfaceResult:
+                  fairness: str = "variation",
+                  vspring_step: float = VSPRING_STEP) -> SurfaceResult:
     """Smooth surface through a curve network's loops (Orbay & Kara 2011, Sec. 4.2-4.3).
 
     Parameters
@@ -117,6 +119,9 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
     curve_weight : float or None
         lsq fit: None interpolates exactly; a positive weight trades interpolation
         for fairness (use with ``update_curves``).
+    vspring_step : float
+        Iterative fit: fraction of the V-spring displacement applied per iteration
+        (1.0 as published; 0.5 by default, see :data:`surfacing.fit.VSPRING_STEP`).
     fairness : {"variation", "thin-plate"}
         lsq fit energy: differences of the control net's umbrella Laplacian across
         edges (linear curvature variation, default) or the Laplacian itself.
@@ -179,7 +184,8 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
         T1, T2, has = tangent_matrices(cm.quads, n, sharp_edges, corners)
         P, iters, _ = fit_iterative(L, T1, T2, has, cm.quads, cm.vertices, cons, targets,
                                     lam=lam, tol=tol * diag, max_iter=max_iter,
-                                    sharp_edges=sharp_edges, corners=corners)
+                                    sharp_edges=sharp_edges, corners=corners,
+                                    vspring_step=vspring_step)
     sample_dev = np.linalg.norm((L @ P)[cons] - targets, axis=1)
     timings["fit"] = time.perf_counter() - t0
 

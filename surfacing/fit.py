@@ -30,7 +30,7 @@ import scipy.sparse.linalg as spla
 from .catmull_clark import CORNER, CREASE, _sharp_mask, edge_topology, vertex_classes
 from .limit import limit_normals
 
-__all__ = ["LAMBDA", "FAIRNESS", "fairness_matrix", "variation_matrix", "fit_lsq",
+__all__ = ["LAMBDA", "VSPRING_STEP", "FAIRNESS", "fairness_matrix", "variation_matrix", "fit_lsq",
            "fit_iterative", "vspring_displacement"]
 
 #: Fairness energies of :func:`fit_lsq`: ``"variation"`` penalises the differences of the
@@ -42,6 +42,10 @@ LAMBDA = 0.5
 #: Tikhonov pull to the initial control points, relative to the fairness term (keeps
 #: the KKT matrix non-singular for vertices the fairness does not reach).
 _TIKHONOV = 1e-9
+#: Step applied to the V-spring displacement. The paper applies it whole (1.0); on
+#: irregular control meshes from real networks that diverges (haopan/roadster: curve
+#: deviation 5% after 50 iterations, 14% after 500), half a step converges.
+VSPRING_STEP = 0.5
 #: Guard for V-spring's ``1 + n_i . n_j`` when the two normals are opposite.
 _VSPRING_DEN_MIN = 1e-2
 
@@ -199,7 +203,8 @@ def vspring_displacement(Q, N, edges, smooth=None) -> np.ndarray:
 
 def fit_iterative(L, T1, T2, has_tangent, quads, P0, constrained, targets, *,
                   lam: float = LAMBDA, tol: float = 1e-4, max_iter: int = 500,
-                  fair_free: bool = True, sharp_edges=None, corners=None):
+                  fair_free: bool = True, sharp_edges=None, corners=None,
+                  vspring_step: float = VSPRING_STEP):
     """Iterative interpolation with V-spring fairing (Orbay & Kara 2011, Eq. 3-4).
 
     Parameters
@@ -220,6 +225,9 @@ def fit_iterative(L, T1, T2, has_tangent, quads, P0, constrained, targets, *,
         Apply V-spring to the free (not on a curve) vertices.
     sharp_edges, corners : optional
         Crease structure (see :mod:`.catmull_clark`), for the V-spring neighbours.
+    vspring_step : float
+        Fraction of the Eq. 4 displacement applied per iteration (1.0 as published;
+        default :data:`VSPRING_STEP`).
 
     Returns
     -------
@@ -247,7 +255,7 @@ def fit_iterative(L, T1, T2, has_tangent, quads, P0, constrained, targets, *,
         step = 0.0
         if fair_free and free.any():
             N = limit_normals(P, quads, T1, T2, has_tangent, L)
-            dv = vspring_displacement(Q, N, edges, smooth)[free]             # Eq. 4
+            dv = vspring_step * vspring_displacement(Q, N, edges, smooth)[free]   # Eq. 4
             P[free] += dv
             step = float(np.sqrt((dv ** 2).sum(1)).max())
         if dev < tol and step < tol:
