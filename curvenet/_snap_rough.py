@@ -55,6 +55,27 @@ def dedup(poly, eps):
     return out
 
 
+def _clean(poly, eps):
+    """Drop interior points closer than ``eps`` to the previous kept point; ends stay exact.
+
+    Removes the needle segments that joins and cuts can leave (their direction is
+    noise and shows as a kink).
+    """
+    if len(poly) <= 2:
+        return poly
+    keep = np.ones(len(poly), dtype=bool)
+    last = poly[0]
+    for i in range(1, len(poly) - 1):  # short loop: only near-duplicate runs matter
+        if np.linalg.norm(poly[i] - last) < eps:
+            keep[i] = False
+        else:
+            last = poly[i]
+    idx = np.flatnonzero(keep)
+    if len(idx) > 2 and np.linalg.norm(poly[-1] - poly[idx[-2]]) < eps:
+        keep[idx[-2]] = False
+    return poly[keep]
+
+
 def _arclength(poly):
     """Cumulative arc length ``(n,)`` of an ``(n, 3)`` polyline."""
     return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(poly, axis=0), axis=1))])
@@ -246,45 +267,58 @@ def _consolidate(st, samples, con, tol, h, opts, report):
         if not cov.any():
             continue
         g0, g1 = ss[gm][cov].min(), ss[gm][cov].max()
-        # host: move halfway onto the guest over [h0, h1], tapered over `ramp` at both ends
-        gtree = cKDTree(Q[gm])
-        hp, hc = st.polys[host], st.cums[host]
-        inside = (hc >= h0) & (hc <= h1)
-        if inside.any():
-            _, nn = gtree.query(hp[inside])
-            ramp = max(min(2.0 * tol, 0.5 * (h1 - h0)), 1e-300)
-            w = _smoothstep((hc[inside] - h0) / ramp) * _smoothstep((h1 - hc[inside]) / ramp)
-            hp = hp.copy()
-            hp[inside] += 0.5 * w[:, None] * (Q[gm][nn] - hp[inside])
-            st.set(host, hp)
+        gp, gc = st.polys[guest], st.cums[guest]
+        gq, gsv = Q[gm], ss[gm]
+        gtree = cKDTree(gq)
+        hp, hc = st.polys[host].copy(), st.cums[host]
+        Lh = hc[-1]
         st.srcs[host] = tuple(sorted(set(st.srcs[host]) | set(st.srcs[guest])))
         if st.labels[guest] == "crease":
             st.labels[host] = "crease"
-        # guest: the pieces outside [g0, g1]. A piece that continues the host past
-        # the host's end (the end lies inside the overlap) is appended to the host,
-        # however short; other pieces stay as strokes if at least `trim * tol` long.
-        gp, gc = st.polys[guest], st.cums[guest]
-        hp = st.polys[host]
-        head_in = h0 <= h                      # host ends lying inside the overlap
-        tail_in = h1 >= st.length(host) - h
-        head, tail = hp[0].copy(), hp[-1].copy()
-        keep_min = opts.trim * tol
-        before, after = [], []
-        for lo, hi, attach_at_start in ((0.0, g0, False), (g1, gc[-1], True)):
+        # guest pieces outside [g0, g1]: one that continues the host past a host end
+        # lying inside the overlap is joined to the host, however short; other pieces
+        # stay as strokes if at least `trim * tol` long.
+        head_in, tail_in = h0 <= h, h1 >= Lh - h
+        join = {}
+        for lo, hi, side in ((0.0, g0, "left"), (g1, gc[-1], "right")):
             if hi - lo <= 0.5 * h:
                 continue
-            piece = _cut(gp, gc, lo, hi)
-            if not attach_at_start:
-                piece = piece[::-1]  # now starts at the overlap
-            pa = piece[0]
-            if tail_in and not after and np.linalg.norm(tail - pa) <= 2.0 * tol:
-                after = [piece]
-            elif head_in and not before and np.linalg.norm(head - pa) <= 2.0 * tol:
-                before = [piece[::-1]]
-            elif hi - lo >= keep_min:
-                new.append((piece, st.srcs[guest], st.labels[guest]))
-        if before or after:
-            st.set(host, np.vstack(before + [hp] + after))
+            pa = _interp(gp, gc, np.array([g0 if side == "left" else g1]))[0]
+            if tail_in and "tail" not in join and np.linalg.norm(hp[-1] - pa) <= 2.0 * tol:
+                join["tail"] = side
+            elif head_in and "head" not in join and np.linalg.norm(hp[0] - pa) <= 2.0 * tol:
+                join["head"] = side
+            elif hi - lo >= opts.trim * tol:
+                new.append((_cut(gp, gc, lo, hi), st.srcs[guest], st.labels[guest]))
+        # host over the overlap: moved halfway onto the guest (the average), tapered to 0
+        # over `ramp` at a free end, and cross-faded to 1 (onto the guest) at a joined end
+        a0 = 0.0 if "head" in join else h0
+        a1 = Lh if "tail" in join else h1
+        inside = (hc >= a0) & (hc <= a1)
+        if inside.any():
+            x = hc[inside]
+            ramp = max(min(2.0 * tol, 0.5 * (h1 - h0)), 1e-300)  # guard: empty overlap
+            lo_f = (1.0 + _smoothstep((h0 + ramp - x) / ramp) if "head" in join
+                    else _smoothstep((x - h0) / ramp))
+            hi_f = (1.0 + _smoothstep((x - h1 + ramp) / ramp) if "tail" in join
+                    else _smoothstep((h1 - x) / ramp))
+            beta = np.minimum(0.5 * lo_f * hi_f, 1.0)
+            _, nn = gtree.query(hp[inside])
+            hp[inside] += beta[:, None] * (gq[nn] - hp[inside])
+        before, after = [], []
+        if "tail" in join:
+            gt = gsv[gtree.query(hp[-1])[1]]
+            if join["tail"] == "right" and gt < gc[-1]:
+                after = [_cut(gp, gc, gt, gc[-1])[1:]]
+            elif join["tail"] == "left" and gt > 0:
+                after = [_cut(gp, gc, 0.0, gt)[::-1][1:]]
+        if "head" in join:
+            gh = gsv[gtree.query(hp[0])[1]]
+            if join["head"] == "right" and gh < gc[-1]:
+                before = [_cut(gp, gc, gh, gc[-1])[::-1][:-1]]
+            elif join["head"] == "left" and gh > 0:
+                before = [_cut(gp, gc, 0.0, gh)[:-1]]
+        st.set(host, _clean(np.vstack(before + [hp] + after), 0.05 * tol))
         removed.add(guest)
         report["overdraw_consolidations"] += 1
     if not busy:
@@ -478,7 +512,6 @@ def _displace_and_split(poly, cum, cuts, disp, tol, opts):
     Returns the list of k + 1 pieces (first and last may be ``None`` when a cut
     sits at the stroke's end).
     """
-    L = cum[-1]
     k = len(cuts)
     gaps = np.diff(np.concatenate([[-np.inf], cuts, [np.inf]]))
     R = np.minimum(opts.blend * tol, 0.45 * np.minimum(gaps[:-1], gaps[1:]))
@@ -486,10 +519,10 @@ def _displace_and_split(poly, cum, cuts, disp, tol, opts):
     s_all = np.concatenate([cum, cuts])
     p_all = np.vstack([poly, _interp(poly, cum, cuts)])
     is_cut = np.concatenate([np.zeros(len(cum), bool), np.ones(k, bool)])
-    # drop polyline vertices that coincide with a cut
+    # drop polyline vertices closer than tol / 10 to a cut: no needle segments there
     near = np.zeros(len(cum), bool)
     if k:
-        near = np.min(np.abs(cum[:, None] - cuts[None, :]), axis=1) < 1e-12 * max(L, 1e-300)
+        near = np.min(np.abs(cum[:, None] - cuts[None, :]), axis=1) < 0.1 * tol
     keep = np.concatenate([~near, np.ones(k, bool)])
     s_all, p_all, is_cut = s_all[keep], p_all[keep], is_cut[keep]
     order = np.argsort(s_all, kind="stable")
@@ -697,7 +730,7 @@ def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
     new_id = {v: i for i, v in enumerate(used)}
     net = CurveNetwork(np.array([verts[v] for v in used]).reshape(-1, 3))
     for u, v, curve, srcs, lab in edges:
-        net.add_edge(new_id[u], new_id[v], curve, strokes=srcs, label=lab)
+        net.add_edge(new_id[u], new_id[v], _clean(curve, 0.05 * tol), strokes=srcs, label=lab)
     net.report = report
     return net
 

@@ -278,6 +278,24 @@ def test_rough_redraw_recovers_graph_ci(name):
     assert _success(name, range(1000, 1020)) >= 0.95
 
 
+@pytest.mark.parametrize("name", ["box", "latlong_sphere", "saddle_grid"])
+def test_snapping_adds_no_kinks(name):
+    """Blending, joins and cuts keep curves as smooth as the strokes they came from.
+
+    Oracle: the largest turn between consecutive segments of any output curve is
+    at most the largest turn in the input strokes plus 15 degrees (the strokes
+    wobble by up to ~30 degrees per segment; a cut or join artefact shows as a
+    needle segment turning 60-180 degrees).
+    """
+    ref = getattr(shapes, name)().network
+    for seed in range(4):
+        sketch = rough_sketch(ref, seed=seed)
+        net = snap(sketch)
+        worst_in = max(max_turn_deg(s) for s in sketch.strokes)
+        worst_out = max(max_turn_deg(e.curve) for e in net.edges if len(e.curve) > 2)
+        assert worst_out <= worst_in + 15.0, (seed, worst_in, worst_out)
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("name", ROUGH)
 def test_rough_redraw_recovers_graph_100_trials(name):
