@@ -56,20 +56,16 @@ def dedup(poly, eps):
 
 
 def _clean(poly, eps):
-    """Drop interior points closer than ``eps`` to the previous kept point; ends stay exact.
+    """Drop interior points closer than ``eps`` to their predecessor; ends stay exact.
 
     Removes the needle segments that joins and cuts can leave (their direction is
-    noise and shows as a kink).
+    noise and shows as a kink). A run of such points is dropped whole, which only
+    lengthens one segment.
     """
     if len(poly) <= 2:
         return poly
     keep = np.ones(len(poly), dtype=bool)
-    last = poly[0]
-    for i in range(1, len(poly) - 1):  # short loop: only near-duplicate runs matter
-        if np.linalg.norm(poly[i] - last) < eps:
-            keep[i] = False
-        else:
-            last = poly[i]
+    keep[1:-1] = np.linalg.norm(np.diff(poly[:-1], axis=0), axis=1) >= eps
     idx = np.flatnonzero(keep)
     if len(idx) > 2 and np.linalg.norm(poly[-1] - poly[idx[-2]]) < eps:
         keep[idx[-2]] = False

@@ -141,9 +141,10 @@ def _label_of(name_tokens) -> str | None:
 def _finish(strokes, labels, lines, path, strict, metadata=None) -> Sketch:
     """Drop (or reject) strokes with fewer than two points and build the Sketch."""
     keep_s, keep_l, warns = [], [], []
-    for s, lab, ln in zip(strokes, labels, lines):
+    for i, (s, lab, ln) in enumerate(zip(strokes, labels, lines)):
         if len(s) < 2:
-            msg = f"stroke starting at line {ln} has {len(s)} point(s); a stroke needs 2"
+            where = f"strokes[{i}]" if ln is None else f"stroke starting at line {ln}"
+            msg = f"{where} has {len(s)} point(s); a stroke needs 2"
             if strict:
                 raise SketchFormatError(msg, path=path, line=ln)
             warns.append(msg)
@@ -626,6 +627,20 @@ def read_network_obj(path, *, max_bytes: int = MAX_FILE_BYTES) -> CurveNetwork:
     polys = [p for p in polys if len(p) >= 2]
     if not polys:
         raise SketchFormatError("no polylines with two or more points", path=path)
+    net = _indexed_network(verts, polys, labels, range(len(polys)))
+    net.report = {"polylines": len(polys), "source": str(path)}
+    return net
+
+
+def _indexed_network(verts, polys, labels, sources) -> CurveNetwork:
+    """Exact graph of polylines given as index arrays into ``verts`` (no tolerance).
+
+    Vertices are the indices that end an open polyline, occur two or more times
+    (over all polylines, a closed polyline's repeated end counted once), or
+    where three or more segments meet; each closed polyline with none of those
+    gets a loop edge at its first point. ``sources[k]`` is stored in
+    ``edge.strokes`` of the pieces of polyline ``k``.
+    """
     nv = len(verts)
     use = np.zeros(nv, dtype=np.int64)
     key = np.zeros(nv, dtype=bool)
@@ -658,8 +673,6 @@ def read_network_obj(path, *, max_bytes: int = MAX_FILE_BYTES) -> CurveNetwork:
             pieces.append((p[a:b + 1], labels[k], k))
     net = CurveNetwork(verts[np.asarray(net_v, dtype=np.int64)])
     for idx, lab, k in pieces:
-        net.add_edge(int(vid[idx[0]]), int(vid[idx[-1]]), verts[idx], strokes=(k,),
+        net.add_edge(int(vid[idx[0]]), int(vid[idx[-1]]), verts[idx], strokes=(int(sources[k]),),
                      label="crease" if lab == "crease" else "boundary")
-    net.report = {"polylines": len(polys), "source": str(path)}
     return net
-
