@@ -76,7 +76,8 @@ def dihedral_angles(cm: ControlMesh, curves: list,
     Returns
     -------
     (C,) float64
-        Mean over the curve's two ends of the angle between the patch normals;
+        Smaller of the angles between the patch normals at the two ends (a crease
+        must look sharp at both ends, which discounts a rough tangent at one junction);
         NaN for curves not used by exactly two loop traversals.
     """
     C = len(curves)
@@ -109,7 +110,7 @@ def dihedral_angles(cm: ControlMesh, curves: list,
         a = [rec.get((ci, e), []) for e in (0, 1)]
         if len(a[0]) == 2 and len(a[1]) == 2:
             ang = [np.degrees(np.arccos(np.clip(np.dot(x[0], x[1]), -1, 1))) for x in a]
-            out[ci] = float(np.mean(ang))
+            out[ci] = float(np.min(ang))
     return out
 
 
