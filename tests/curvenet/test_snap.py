@@ -326,3 +326,35 @@ def test_rough_data_sketches_snap_and_report(data_dir):
         assert len(used) + net.report["strokes_dropped_short"] >= 0.5 * len(sketch), f.name
         for e in net.edges:
             assert np.isfinite(e.curve).all()
+
+
+# --------------------------------------------------------------------------- properties
+try:
+    from hypothesis import given, settings
+    from hypothesis import strategies as st
+except ImportError:  # pragma: no cover - hypothesis is a test dependency
+    given = None
+
+if given is not None:
+    @settings(max_examples=40, deadline=None)
+    @given(st.integers(0, 2**32 - 1), st.integers(1, 12), st.floats(0.005, 0.1))
+    def test_random_scribbles_give_a_valid_network(seed, n, tol):
+        """Any scribble snaps without error into a consistent network."""
+        rng = np.random.default_rng(seed)
+        strokes = []
+        for _ in range(n):
+            k = int(rng.integers(2, 40))
+            steps = rng.normal(size=(k, 3)) * rng.uniform(0.01, 0.3)
+            strokes.append(np.cumsum(steps, axis=0) + rng.uniform(-1, 1, 3))
+        if rng.random() < 0.3:  # repeated points and an exact copy
+            strokes.append(np.repeat(strokes[0], 2, axis=0))
+        net = snap(Sketch(strokes), snap_tol=tol)
+        assert net.number_of_edges >= 1
+        for e in net.edges:
+            assert np.isfinite(e.curve).all() and len(e.curve) >= 2
+            np.testing.assert_array_equal(e.curve[0], net.positions[e.u])
+            np.testing.assert_array_equal(e.curve[-1], net.positions[e.v])
+        deg = np.bincount(net.endpoints.ravel(), minlength=net.number_of_vertices)
+        assert (deg > 0).all()  # no isolated vertices
+        assert net.report["dangling_ends"] == int((deg == 1).sum())
+        assert net.cycle_rank() >= 0
