@@ -261,6 +261,15 @@ def _grid_quads(G):
     return np.stack([a.ravel(), b.ravel(), c.ravel(), d.ravel()], axis=1)
 
 
+def _local_quads(subs, B, new_lo, n_new):
+    """Quads of a split loop in local numbering: border ``B`` first, then the new ids."""
+    quads = np.concatenate([_grid_quads(G) for G in subs])
+    ids_all = np.concatenate([B, new_lo + np.arange(n_new)])
+    lut = np.full(int(ids_all.max()) + 1, -1, dtype=np.int64)
+    lut[ids_all] = np.arange(len(ids_all))
+    return ids_all, lut[quads]
+
+
 def _tutte_square(quads_local, n_local, bnd_local, bnd_uv):
     """Uniform harmonic map of a local quad mesh with the border pinned to ``bnd_uv (b, d)``."""
     e = np.concatenate([quads_local[:, [0, 1]], quads_local[:, [1, 2]],
@@ -418,10 +427,7 @@ def build_control_mesh(curves, loops, resolution: int = 4, *,
         newpos = np.zeros((n_new, 3))
         if kind == "split-coons4":
             # local mesh -> Tutte embedding in the unit square -> 4-sided Coons patch
-            quads_loc = np.concatenate([_grid_quads(G) for G in subs])
-            ids_all = np.concatenate([B, new_lo + np.arange(n_new)])
-            lut = {int(v): k for k, v in enumerate(ids_all)}
-            ql = np.vectorize(lut.__getitem__)(quads_loc)
+            ids_all, ql = _local_quads(subs, B, new_lo, n_new)
             corners = [starts[s[0]] for s in sides]
             uvb = np.zeros((Lb, 2))
             side_pts = []
@@ -440,10 +446,7 @@ def build_control_mesh(curves, loops, resolution: int = 4, *,
             # harmonic (uniform-weight) interior: the 3D image of a Tutte embedding into
             # a convex polygon, so it cannot fold the way straight spokes do in a
             # concave loop (the L of an L-prism)
-            quads_loc = np.concatenate([_grid_quads(G) for G in subs])
-            ids_all = np.concatenate([B, new_lo + np.arange(n_new)])
-            lut = {int(v): k for k, v in enumerate(ids_all)}
-            ql = np.vectorize(lut.__getitem__)(quads_loc)
+            ids_all, ql = _local_quads(subs, B, new_lo, n_new)
             xyz = _tutte_square(ql, len(ids_all), np.arange(Lb), BP)
             newpos = xyz[Lb:]
         positions.append(newpos)
