@@ -138,3 +138,14 @@ def test_soapfilm_api():
     V, F = surfacing.soapfilm(curves, s.faces, subdiv=3)
     m = trimesh.Trimesh(V, F, process=False)
     assert m.is_watertight and m.is_winding_consistent
+
+
+@pytest.mark.parametrize("name", ["house", "grid_box", "two_boxes", "grid_sheet"])
+def test_flat_faced_shapes_are_reproduced(name):
+    # planar faces bounded by straight crease / boundary curves: the limit surface is the
+    # polyhedron itself (two_boxes shares a face between two solids: a non-manifold curve
+    # set, each manifold piece subdivided with the shared curves as its boundary)
+    s, curves, cr, res = _run(name)
+    ref = s.reference_mesh()
+    m = compare(res.vertices, res.faces, ref.vertices, ref.faces, n=5000)
+    assert m["chamfer"] < 1e-6 and m["fscore"] == 1.0
