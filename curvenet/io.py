@@ -171,7 +171,65 @@ def _split_lines(text):
 
 # --------------------------------------------------------------------------- OBJ
 def _parse_obj(text, path):
-    """Parse OBJ text into vertices and polylines.
+    """Parse OBJ text into vertices and polylines (fast path, slow path on any anomaly).
+
+    The fast path handles the common layout (``v x y z`` and ``l i j ...`` records
+    starting in column 0, integer or ``i/t`` indices) with two C-level
+    ``numpy.fromstring`` calls; anything else (extra vertex columns, tabs, a bad
+    token, index 0) falls back to :func:`_parse_obj_slow`, which also produces
+    the error messages with line numbers.
+    """
+    lines = text.splitlines()
+    v_idx, l_idx, g_idx = [], [], []
+    for i, ln in enumerate(lines):
+        c = ln[:2]
+        if c == "v ":
+            v_idx.append(i)
+        elif c == "l ":
+            l_idx.append(i)
+        elif c in ("g ", "o ", "g", "o"):
+            g_idx.append(i)
+        elif ln and ln[0] not in "#vf" and ln.strip() and not ln.lstrip().startswith("#"):
+            if ln.split()[0] in ("v", "l", "g", "o"):
+                return _parse_obj_slow(text, path)
+        elif c in ("v\t", "l\t"):
+            return _parse_obj_slow(text, path)
+    if not v_idx or not l_idx:
+        return _parse_obj_slow(text, path)
+    try:
+        verts = np.fromstring("\n".join([lines[i][2:] for i in v_idx]), sep=" ")
+        ltext = " 0 ".join([lines[i][2:] for i in l_idx]) + " 0"
+        if "/" in ltext:
+            ltext = re.sub(r"/\S*", "", ltext)
+        flat = np.fromstring(ltext, sep=" ", dtype=np.int64)
+    except ValueError:
+        return _parse_obj_slow(text, path)
+    if verts.size != 3 * len(v_idx) or not np.isfinite(verts).all():
+        return _parse_obj_slow(text, path)
+    zeros = np.flatnonzero(flat == 0)
+    if len(zeros) != len(l_idx):
+        return _parse_obj_slow(text, path)
+    counts = np.diff(np.concatenate([[-1], zeros])) - 1
+    if (counts < 1).any():
+        return _parse_obj_slow(text, path)
+    idx = flat[flat != 0]
+    owner = np.repeat(np.arange(len(l_idx)), counts)
+    nv_at = np.searchsorted(np.asarray(v_idx), np.asarray(l_idx))[owner]
+    idx = np.where(idx < 0, nv_at + idx, idx - 1)
+    if ((idx < 0) | (idx >= nv_at)).any():
+        return _parse_obj_slow(text, path)
+    labels_at = ["boundary"]
+    for i in g_idx:
+        lab = _label_of(lines[i].split()[1:])
+        labels_at.append(lab if lab is not None else "boundary")
+    which = np.searchsorted(np.asarray(g_idx, dtype=np.int64), np.asarray(l_idx))
+    polys = np.split(idx, np.cumsum(counts)[:-1])
+    return (verts.reshape(-1, 3), polys, [labels_at[w] for w in which.tolist()],
+            [i + 1 for i in l_idx])
+
+
+def _parse_obj_slow(text, path):
+    """Parse OBJ text into vertices and polylines, token by token.
 
     Returns
     -------
