@@ -141,9 +141,9 @@ def test_basis_invariants_hypothesis(seed, n, m):
     net = random_network(seed, n=n, m=m)
     ps = find_patches(net, close="auto")
     r = net.cycle_rank()
-    auto = [p for p in ps.patches if p.source == "auto"]
+    auto = [p.edges for p in ps.patches if p.source == "auto"] + ps.report["handle_cycles"]
     assert len(auto) == r
-    assert gf2_rank([edge_mask(p.edges) for p in auto], max(net.number_of_edges, 1)) == r
+    assert gf2_rank([edge_mask(p) for p in auto], max(net.number_of_edges, 1)) == r
 
 
 @pytest.mark.parametrize("seed", range(8))
@@ -193,7 +193,7 @@ def _brute_force_basis_weights(net: CurveNetwork):
 def test_greedy_weight_is_minimum(seed):
     """Theorem 1: the greedy basis has the minimum multiset of k (simple graphs)."""
     keep = random_simple_network(seed, n=8, m=14)
-    ps = find_patches(keep, close="none")
+    ps = find_patches(keep, close="none", genus_aware=False)
     pool = CandidatePool(keep)
     ks = sorted(len(p.edges) + (2 + SEPARATING_EPS) * pool.is_separating(
         {v for e in p.edges for v in (keep.edges[e].u, keep.edges[e].v)}) for p in ps.patches)
@@ -381,7 +381,7 @@ def test_runs_on_public_networks(data_dir):
         ps = find_patches(net)
         assert ps.report["full_rank"], f
         auto = [p for p in ps.patches if p.source == "auto"]
-        assert len(auto) == net.cycle_rank()
+        assert len(auto) + len(ps.report["handle_cycles"]) == net.cycle_rank()
         for p in ps.patches:
             cycle_to_loop(net, p.edges)
 
@@ -395,3 +395,21 @@ def test_tree_and_empty_networks_have_no_patches():
     tree.add_edge(0, 2, [[0, 0, 0], [0, 1, 0]])
     ps = find_patches(tree)
     assert ps.patches == [] and ps.report["rank"] == 0
+
+
+@pytest.mark.parametrize("shape", [shapes.torus(), shapes.torus(n_u=8, n_v=6),
+                                   shapes.torus(n_u=5, n_v=4, minor=0.6)])
+def test_torus_gives_exactly_its_faces(shape):
+    """Genus 1: the two handle rings complete the basis but are not patches.
+
+    (A ring shorter than the faces, e.g. 3 curves around a tube of 4-sided
+    faces, still wins on k alone; that case is out of reach of a tie-break.)"""
+    ps = find_patches(shape.network)
+    assert found(ps) == set(shape.face_edge_sets())
+    assert len(ps.report["handle_cycles"]) == 2 and ps.report["order"] == "genus_aware"
+    assert ps.report["manifold_defect"]["genus_aware"] == 0
+    # the paper's weights alone pick planar handle rings over curved faces
+    assert found(find_patches(shape.network, genus_aware=False)) != set(shape.face_edge_sets())
+    # the basis itself stays a full basis
+    basis = find_patches(shape.network, close="none")
+    assert len(basis.patches) == shape.network.cycle_rank()
