@@ -1,6 +1,7 @@
 """Benchmark: snapping rough sketches (target: 1,000 strokes x 100 points in < 2 s).
 
-Run ``python benchmarks/bench_snap.py``. Prints one row per case: strokes,
+Run ``python benchmarks/bench_snap.py`` (``--data ../shared/data`` prints one line
+of snapping statistics per public data file instead). Prints one row per case: strokes,
 points, seconds (best of ``--repeat``), and whether the snapped graph matches
 the clean network it was re-drawn from (:func:`curvenet.redraw.match_networks`).
 
@@ -13,6 +14,7 @@ from __future__ import annotations
 
 import argparse
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -55,10 +57,51 @@ def _time(fn, repeat):
     return (best, best_cpu), out
 
 
+def data_table(root):
+    """One line of snapping statistics per public data file (networks, vns, cassie, stability)."""
+    import warnings
+
+    from curvenet.io import read_network_obj, read_sketch
+
+    root = Path(root)
+    print(f"{'file':44s} {'mode':5s} {'str':>4s} {'V':>5s} {'E':>5s} {'ref V,E':>9s} {'jun':>4s} "
+          f"{'T':>3s} {'gap':>3s} {'trim':>4s} {'odr':>3s} {'cor':>3s} {'dang':>4s} {'drop':>4s} "
+          f"{'sec':>5s}")
+    groups = [sorted((root / "networks").glob("*/*.obj")),
+              sorted((root / "sketches" / "vns").rglob("*.obj")),
+              sorted((root / "sketches" / "cassie" / "curves").glob("*.curves")),
+              sorted((root / "surfaces" / "stability" / "input" / "curves").glob("*.txt"))]
+    for f in [f for g in groups for f in g]:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            sk = read_sketch(f)
+        t = time.perf_counter()
+        net = snap(sk)
+        dt = time.perf_counter() - t
+        r = net.report
+        ref = "-"
+        if f.parent.parent.name == "networks":
+            rn = read_network_obj(f)
+            ok = (rn.number_of_vertices, rn.number_of_edges) == (net.number_of_vertices,
+                                                                  net.number_of_edges)
+            ref = f"{rn.number_of_vertices},{rn.number_of_edges}" + ("" if ok else "!")
+        name = str(f.relative_to(root))
+        print(f"{name:44s} {r['mode']:5s} {len(sk):4d} {net.number_of_vertices:5d} "
+              f"{net.number_of_edges:5d} {ref:>9s} {r['junctions']:4d} {r['t_junctions']:3d} "
+              f"{r['gap_merges']:3d} {r['trimmed_overshoots']:4d} "
+              f"{r['overdraw_consolidations']:3d} {r['corners']:3d} {r['dangling_ends']:4d} "
+              f"{r['strokes_dropped_short']:4d} {dt:5.2f}")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--data", metavar="DIR", help="print per-file statistics for the public "
+                    "data folder (e.g. ../shared/data) instead of timing")
     args = ap.parse_args(argv)
+    if args.data:
+        data_table(args.data)
+        return
     rows = []
     for name in ("box", "l_prism", "latlong_sphere", "saddle_grid"):
         ref = getattr(shapes, name)().network
