@@ -14,15 +14,12 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ._snap_rough import _arclength
 from .errors import InvalidParameterError
 from .network import CurveNetwork
 from .sketch import Sketch
 
 __all__ = ["rough_sketch", "match_networks"]
-
-
-def _arclength(c):
-    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(c, axis=0), axis=1))])
 
 
 def _at(c, cum, s):
