@@ -58,8 +58,6 @@ def marching_cubes_world(f_grid: np.ndarray, origin: np.ndarray, spacing: float,
     if not (f.min() < level < f.max()):
         return np.zeros((0, 3)), np.zeros((0, 3), dtype=np.int64)
     verts, faces, _, _ = marching_cubes(f, level=level)
-    # skimage orients faces towards decreasing values; flip to point along grad f
-    faces = faces[:, ::-1]
     return (np.asarray(origin, float) + verts.astype(np.float64) * spacing,
             np.ascontiguousarray(faces, dtype=np.int64))
 

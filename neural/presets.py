@@ -74,6 +74,10 @@ class FlowConfig:
         (double backward) for the covariant derivative of II (Eq. 18).
     prefit_steps : int
         Steps fitting g to sigma * grad SDF of ``init_mesh`` (refinement only).
+    geometric_init_steps : int
+        Steps fitting g to the gradient of a sphere around the strokes before
+        the initialisation stage (0 = plain SIREN initialisation, as the paper
+        text; the published code uses a sphere initialisation).
     dtype : str
         ``"float32"`` or ``"float64"``.
     """
@@ -102,6 +106,7 @@ class FlowConfig:
     surface_sampler: str = "cells"
     smooth_mode: str = "jet"
     prefit_steps: int = 150
+    geometric_init_steps: int = 100
     dtype: str = "float32"
 
     def as_dict(self) -> dict:
@@ -114,7 +119,8 @@ PRESETS: dict[str, FlowConfig] = {
                         n_volume=600, init_steps=40, steps=100, lr=3e-4, poisson_every=1),
     "default": FlowConfig(),
     "paper": FlowConfig(res=256, width=256, hidden_layers=4, n_stroke=10000, n_surface=15000,
-                        n_volume=15000, init_steps=200, steps=800, lr=5e-5),
+                        n_volume=15000, init_steps=200, steps=800, lr=5e-5,
+                        geometric_init_steps=0),
 }
 
 _CHOICES = {"surface_sampler": ("cells", "marching_cubes"), "smooth_mode": ("jet", "autograd"),
@@ -156,7 +162,8 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
         v = getattr(cfg, name)
         if int(v) != v or v < 1:
             raise ValueError(f"{name} must be a positive integer, got {v!r}")
-    for name in ("hidden_layers", "init_steps", "steps", "prefit_steps"):
+    for name in ("hidden_layers", "init_steps", "steps", "prefit_steps",
+                 "geometric_init_steps"):
         v = getattr(cfg, name)
         if int(v) != v or v < 0:
             raise ValueError(f"{name} must be a non-negative integer, got {v!r}")

@@ -1,0 +1,34 @@
+"""Preset values (paper settings) and validation of overrides."""
+
+import pytest
+
+from neural.presets import PRESETS, get_config
+
+
+def test_paper_preset_matches_published_settings():
+    c = get_config("paper")
+    assert (c.res, c.width, c.hidden_layers, c.omega_0) == (256, 256, 4, 30.0)
+    assert (c.n_stroke, c.n_surface, c.n_volume) == (10000, 15000, 15000)
+    assert (c.init_steps, c.steps) == (200, 800)
+    assert (c.w_align, c.w_smooth, c.w_data, c.w_eik, c.w_curl) == (1.0, 0.01, 30.0, 7.0, 7.0)
+    assert (c.sigma, c.padding) == (0.5, 0.2)
+
+
+def test_overrides_and_presets():
+    assert set(PRESETS) == {"draft", "default", "paper"}
+    assert get_config("draft", res=96, w_smooth=0.0).res == 96
+    assert get_config("draft").res < get_config("default").res < get_config("paper").res
+
+
+@pytest.mark.parametrize("kw,match", [({"res": 4}, "res"), ({"steps": -1}, "steps"),
+                                      ({"bogus": 1}, "unknown"), ({"lr": 0}, "lr"),
+                                      ({"surface_sampler": "x"}, "surface_sampler"),
+                                      ({"normalize_from": 2.0}, "normalize_from")])
+def test_bad_overrides(kw, match):
+    with pytest.raises(ValueError, match=match):
+        get_config("draft", **kw)
+
+
+def test_bad_quality():
+    with pytest.raises(ValueError, match="quality"):
+        get_config("best")
