@@ -83,7 +83,7 @@ DEFAULT_SNAP_TOL = 0.025
 #: Counters present in every ``network.report`` (see :func:`snap`).
 _COUNTERS = ("crossings", "t_junctions", "gap_merges", "closed_strokes", "trimmed_overshoots",
              "overdraw_consolidations", "corners", "dissolved_joins", "slivers_merged",
-             "strokes_dropped_short")
+             "strokes_dropped_short", "strokes_trimmed_away")
 
 _EXACT_EPS = 1e-9   # coincidence tolerance of exact mode, fraction of the diagonal
 _MAX_SAMPLES = 2_000_000
@@ -245,7 +245,12 @@ def snap(sketch: Sketch, *, snap_tol: float = DEFAULT_SNAP_TOL, corner_angle: fl
         ``crossings``, ``gap_merges``, ``closed_strokes``, ``trimmed_overshoots``,
         ``overdraw_consolidations``, ``corners``, ``dissolved_joins``,
         ``slivers_merged``, ``dangling_ends`` (count) and ``dangling_vertices``
-        (ids), ``strokes_used``, ``strokes_dropped_short``, ``warnings`` (list).
+        (ids), ``strokes_used``, ``strokes_dropped_short`` (fewer than two
+        distinct points, or shorter than ``min_length * tol``),
+        ``strokes_trimmed_away`` (short strokes whose every piece was a trimmed
+        overshoot: no edge lists them), ``warnings`` (list). Every boundary or
+        crease stroke is in some edge's ``strokes`` or counted in one of the
+        last two.
 
     Raises
     ------
@@ -301,6 +306,9 @@ def snap(sketch: Sketch, *, snap_tol: float = DEFAULT_SNAP_TOL, corner_angle: fl
         return net
     from ._snap_rough import snap_rough
     net = snap_rough(strokes, src, labels, diag, opts)
+    present = {s for e in net.edges for s in e.strokes}
+    net.report["strokes_trimmed_away"] = (sum(1 for s in src if s not in present)
+                                          - net.report["strokes_dropped_short"])
     net.report["strokes_dropped_short"] += dropped
     net.report.update(_common_report(net, diag, opts, len(strokes), None))
     return net
