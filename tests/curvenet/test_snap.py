@@ -52,7 +52,7 @@ def test_near_crossing_becomes_junction_smoothly():
     deg = np.bincount(net.endpoints.ravel())
     j = int(np.argmax(deg))
     # placed at the midpoint of the closest points (Abbasinejad Sec. 6.1)
-    np.testing.assert_allclose(net.positions[j], [0, 0, 0.01], atol=0.01)
+    np.testing.assert_allclose(net.positions[j], [0, 0, 0.01], atol=1e-9)
     # both strokes moved onto it with C1 blending: no kink anywhere (the input turns 0 deg)
     for e in net.edges:
         assert max_turn_deg(e.curve) < 3.0
@@ -176,6 +176,24 @@ def test_prune_dangling():
     assert dangling_vertices(pruned).size == 0
     assert pruned.report["pruned_edges"] == 4
     assert pruned.cycle_rank() == net.cycle_rank()
+
+
+def test_segment_closest_points_match_brute_force():
+    from curvenet._snap_rough import _seg_seg
+
+    rng = np.random.default_rng(0)
+    p0, p1, q0, q1 = (rng.normal(size=(300, 3)) for _ in range(4))
+    p1[:20] = p0[:20] + (q1[:20] - q0[:20])  # parallel pairs
+    s, t = _seg_seg(p0, p1, q0, q1)
+    d = np.linalg.norm(p0 + s[:, None] * (p1 - p0) - q0 - t[:, None] * (q1 - q0), axis=1)
+    g = np.linspace(0, 1, 301)
+    for k in range(300):
+        A = p0[k] + g[:, None] * (p1[k] - p0[k])
+        B = q0[k] + g[:, None] * (q1[k] - q0[k])
+        brute = np.linalg.norm(A[:, None] - B[None], axis=2).min()
+        assert d[k] <= brute + 1e-12  # never worse than the 301 x 301 grid
+        spacing = (np.linalg.norm(p1[k] - p0[k]) + np.linalg.norm(q1[k] - q0[k])) / 300
+        assert d[k] >= brute - spacing  # and better only by the grid spacing
 
 
 # --------------------------------------------------------------------------- invariants
