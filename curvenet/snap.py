@@ -259,8 +259,11 @@ def snap(sketch: Sketch, *, snap_tol: float = DEFAULT_SNAP_TOL, corner_angle: fl
 
     Notes
     -----
-    See the module docstring for the steps and their constants. Vertex order:
-    junctions in order of first appearance along the strokes, then free ends.
+    See the module docstring for the steps and their constants. Vertex order
+    (rough mode): junctions (by the stroke pair of the first contact that made
+    them), then corners, then free ends, each in stroke order; edges in stroke
+    order, a stroke's pieces from its start. Exact mode numbers vertices as
+    :func:`curvenet.io.read_network_obj` does, by first point index.
 
     References
     ----------
