@@ -1,0 +1,164 @@
+"""Benchmark of the flow-aligned neural surfacing (neural.flow, Zhang et al. 2025).
+
+Run from the repository root::
+
+    python benchmarks/bench_neural.py                 # everything (long on 2 cores)
+    python benchmarks/bench_neural.py --only draft100 steps reference vns
+
+Sections
+--------
+draft100   ``draft`` on a ~100-stroke sketch of ../shared/data/sketches/vns (target < 90 s)
+steps      seconds per full-stage step of ``default`` and ``paper`` at 128^3 and 256^3
+reference  ``default`` on an 18-stroke rough sphere: time, peak memory, F-score, Chamfer,
+           next to the published code's figures on this CPU (128^3, 300 steps: ~22 min,
+           13.8 GB, F 99.8 %, Chamfer 2.6e-3)
+vns        ``draft`` time per sketch on several vns sketches, PNG previews under /tmp
+
+Each measurement runs in a fresh subprocess so that peak memory (ru_maxrss) is its own.
+The machine is shared: note the load average printed with the table.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = Path(os.environ.get("CURVENET_DATA", ROOT.parent / "shared" / "data"))
+REFERENCE = {"time_s": 22 * 60, "peak_gb": 13.8, "fscore": 0.998, "chamfer": 2.6e-3}
+
+
+def _worker(spec: dict) -> dict:
+    """One measurement in this process (called through a subprocess)."""
+    import resource
+
+    import torch
+    torch.set_num_threads(spec.get("threads", 2))
+    sys.path.insert(0, str(ROOT))
+    from neural.flow import fit_flow_surface
+    out = {}
+    if spec["kind"] == "sketch":
+        from curvenet.io import read_sketch
+        sk = read_sketch(spec["path"])
+        strokes, labels = sk.strokes, sk.labels
+    else:
+        from curvenet.redraw import rough_sketch
+        from curvenet.shapes import latlong_sphere
+        shape = latlong_sphere(n_lat=2, n_lon=6)
+        sk = rough_sketch(shape.network, seed=0, split=0.0, overdraw=0.0)
+        strokes, labels = sk.strokes, sk.labels
+    out["strokes"] = len(strokes)
+    t = time.perf_counter()
+    r = fit_flow_surface(strokes, labels=labels, quality=spec["quality"], progress=False,
+                         **spec.get("overrides", {}))
+    out["time_s"] = time.perf_counter() - t
+    out["timings"] = r.timings
+    out["steps"] = r.report["steps"]
+    out["faces"] = len(r.faces)
+    out["peak_gb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e6
+    if spec["kind"] == "sphere":
+        from tests.neural._metrics import fscore
+        ref = shape.reference_mesh(5)
+        out["fscore"], out["chamfer"] = fscore(r.vertices, r.faces, ref.vertices, ref.faces)
+    if spec.get("png"):
+        _render(r.vertices, r.faces, strokes, spec["png"])
+        out["png"] = spec["png"]
+    return out
+
+
+def _render(V, F, strokes, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+    fig = plt.figure(figsize=(10, 5))
+    for i, (elev, azim) in enumerate([(20, 30), (20, 210)]):
+        ax = fig.add_subplot(1, 2, i + 1, projection="3d")
+        if len(F):
+            ax.plot_trisurf(V[:, 0], V[:, 1], V[:, 2], triangles=F, color="0.8",
+                            edgecolor="none", alpha=0.9, shade=True)
+        for s in strokes:
+            ax.plot(s[:, 0], s[:, 1], s[:, 2], "r-", lw=0.6)
+        pts = np.vstack(strokes)
+        c, r = pts.mean(0), (pts.max(0) - pts.min(0)).max() / 2
+        ax.set_xlim(c[0] - r, c[0] + r)
+        ax.set_ylim(c[1] - r, c[1] + r)
+        ax.set_zlim(c[2] - r, c[2] + r)
+        ax.view_init(elev, azim)
+        ax.set_axis_off()
+    fig.tight_layout()
+    fig.savefig(path, dpi=80)
+    plt.close(fig)
+
+
+def _run(spec: dict, timeout: float = 3600) -> dict:
+    cmd = [sys.executable, __file__, "--worker", json.dumps(spec)]
+    p = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, cwd=ROOT)
+    if p.returncode != 0:
+        return {"error": p.stderr.strip().splitlines()[-1] if p.stderr.strip() else "failed"}
+    return json.loads(p.stdout.strip().splitlines()[-1])
+
+
+def _row(*cols):
+    print(" | ".join(str(c) for c in cols), flush=True)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--only", nargs="*", default=["draft100", "steps", "reference", "vns"])
+    ap.add_argument("--threads", type=int, default=2)
+    ap.add_argument("--vns", nargs="*", default=["bulbasaur", "guitar", "phone_flowrep",
+                                                  "trebol_flowrep", "torus"])
+    ap.add_argument("--worker", help=argparse.SUPPRESS)
+    a = ap.parse_args(argv)
+    if a.worker:
+        print(json.dumps(_worker(json.loads(a.worker))))
+        return
+    print(f"# load average at start: {os.getloadavg()} (2 shared cores)")
+    vns = DATA / "sketches" / "vns"
+    if "draft100" in a.only:
+        path = vns / "input" / "gamepad.obj"
+        r = _run({"kind": "sketch", "path": str(path), "quality": "draft",
+                  "threads": a.threads, "png": "/tmp/neural_gamepad.png"})
+        _row("draft100", path.name, f"strokes={r.get('strokes')}",
+             f"time={r.get('time_s', float('nan')):.1f}s (target < 90 s)",
+             f"peak={r.get('peak_gb', float('nan')):.2f}GB", r.get("error", ""))
+    if "steps" in a.only:
+        for quality in ("default", "paper"):
+            for res in (128, 256):
+                n = 2
+                r = _run({"kind": "sketch", "path": str(vns / "input" / "gamepad.obj"),
+                          "quality": quality, "threads": a.threads,
+                          "overrides": {"res": res, "init_steps": 1, "steps": n}})
+                per = r["timings"]["full"] / n if "timings" in r else float("nan")
+                _row("steps", quality, f"{res}^3", f"{per:.2f} s/step (full stage)",
+                     f"peak={r.get('peak_gb', float('nan')):.2f}GB", r.get("error", ""))
+    if "reference" in a.only:
+        r = _run({"kind": "sphere", "quality": "default", "threads": a.threads})
+        _row("reference", "method", "time", "peak memory", "F-score@0.01", "Chamfer")
+        _row("reference", "published code, 128^3 x 300 steps", f"{REFERENCE['time_s']:.0f}s",
+             f"{REFERENCE['peak_gb']:.1f}GB", f"{REFERENCE['fscore']:.3f}",
+             f"{REFERENCE['chamfer']:.2e}")
+        if "error" in r:
+            _row("reference", "ours default", r["error"])
+        else:
+            _row("reference", f"ours default ({r['strokes']} strokes)", f"{r['time_s']:.0f}s",
+                 f"{r['peak_gb']:.2f}GB", f"{r['fscore']:.3f}", f"{r['chamfer']:.2e}")
+    if "vns" in a.only:
+        for name in a.vns:
+            path = vns / f"{name}.obj"
+            r = _run({"kind": "sketch", "path": str(path), "quality": "draft",
+                      "threads": a.threads, "png": f"/tmp/neural_{name}.png"})
+            _row("vns", name, f"strokes={r.get('strokes')}",
+                 f"time={r.get('time_s', float('nan')):.1f}s", f"faces={r.get('faces')}",
+                 r.get("png", ""), r.get("error", ""))
+    print(f"# load average at end: {os.getloadavg()}")
+
+
+if __name__ == "__main__":
+    main()
