@@ -12,7 +12,7 @@ box sketch with its 12 edges labelled ``crease`` (``curvenet.shapes.box``, rough
 them (same network, data and steps), normal error against the true box
 (``curvenet.evaluate``: mean angle between normals at closest points, both directions) and
 the dihedral angles across the crease strokes; writes ``benchmarks/results/box_creases.png``.
-The input surface is a rounded box (marching cubes of a box SDF rounded by 0.1, standing in
+The input surface is a rounded box (marching cubes of a box SDF rounded by 0.05, standing in
 for a rounded neural fit), the flow-aligned fit of ``neural.flow`` (``--input flow``), or the
 true box (``--input true``).
 """
@@ -105,7 +105,7 @@ def bench_feature(args) -> None:
 
 
 # ------------------------------------------------------------------------------ box creases
-def rounded_box_mesh(radius: float = 0.1, res: int = 72):
+def rounded_box_mesh(radius: float = 0.05, res: int = 96):
     """Unit box with edges rounded by ``radius`` (marching cubes of its SDF)."""
     from skimage.measure import marching_cubes
 
@@ -239,7 +239,7 @@ def bench_box(args) -> None:
     rows = {}
     for name, (v, f) in results.items():
         m = evaluate_mesh((v, f), ref, n_samples=30000, seed=0)
-        dih = dihedral_angles(v, f, clean, r0=2.5 * voxel, r1=6.0 * voxel)
+        dih = dihedral_angles(v, f, clean, r0=3.5 * voxel, r1=8.0 * voxel)
         dev = np.abs(dih - 90.0)
         rows[name] = (m["normal_error_deg"], m["chamfer"], dih)
         print(f"{name:18s} {m['normal_error_deg']:10.2f} {m['chamfer']:9.2e} "

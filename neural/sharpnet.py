@@ -278,6 +278,11 @@ class SharpNet(nn.Module):
         Activation constants.
     out_bias : float
         Initial bias of the output layer.
+    geometric_init : float, optional
+        Softplus only: the geometric initialisation of Atzmon & Lipman (SAL, 2020) so that
+        the initial network is about the SDF of a sphere of this radius; the positional-
+        encoding and feature columns of the first layer start at 0 (as in IDR/NeuS). Not in
+        the SharpNet paper; it makes short CPU fits of SDFs converge.
 
     Notes
     -----
@@ -286,7 +291,8 @@ class SharpNet(nn.Module):
 
     def __init__(self, dim: int, features: FeatureSet | None = None, *, hidden: int = 256,
                  layers: int = 4, n_freqs: int = 4, activation: str = "softplus",
-                 beta: float = SOFTPLUS_BETA, omega_0: float = 30.0, out_bias: float = 0.0):
+                 beta: float = SOFTPLUS_BETA, omega_0: float = 30.0, out_bias: float = 0.0,
+                 geometric_init: float | None = None):
         super().__init__()
         if dim not in (2, 3):
             raise ValueError(f"dim must be 2 or 3, got {dim!r}")
@@ -316,6 +322,16 @@ class SharpNet(nn.Module):
             last.bias.fill_(out_bias)
         mods.append(last)
         self.mlp = nn.Sequential(*mods)
+        if geometric_init is not None and activation == "softplus":
+            lins = [m for m in mods if isinstance(m, nn.Linear)]
+            with torch.no_grad():
+                for i, lin in enumerate(lins[:-1]):
+                    lin.weight.normal_(0.0, math.sqrt(2.0) / math.sqrt(lin.out_features))
+                    lin.bias.zero_()
+                    if i == 0:
+                        lin.weight[:, dim:] = 0.0
+                last.weight.normal_(math.sqrt(math.pi) / math.sqrt(hidden), 1e-4)
+                last.bias.fill_(-float(geometric_init))
 
     def encode(self, x: torch.Tensor) -> torch.Tensor:
         """Network input ``[PE(x), f(x)]``, ``(n, n_in)``."""

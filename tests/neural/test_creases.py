@@ -100,15 +100,20 @@ def test_box_feature_set_channels_and_crease():
     tri = mv[mt[k]]
     nrm = np.cross(tri[1] - tri[0], tri[2] - tri[0])
     nrm /= np.linalg.norm(nrm)
-    p = torch.tensor(tri.mean(0), dtype=D)
-    n = torch.tensor(nrm, dtype=D)
-    vt = torch.tensor(mv, dtype=D)
+    assert abs(_normal_jump(mv, mt, tri.mean(0), nrm) - 1.0) < 1e-5
+
+
+def _normal_jump(verts, elements, p, n, eps=1e-8):
+    """One-sided normal derivatives of the global feature function at p, + minus -."""
+    p = torch.tensor(p, dtype=D)
+    n = torch.tensor(n, dtype=D)
+    vt = torch.tensor(verts, dtype=D)
     d = []
     for s in (1.0, -1.0):
-        q = (p + s * 1e-8 * n).reshape(1, 3).clone().requires_grad_(True)
-        (g,) = torch.autograd.grad(feature_function(q, vt, mt).sum(), q)
+        q = (p + s * eps * n).reshape(1, -1).clone().requires_grad_(True)
+        (g,) = torch.autograd.grad(feature_function(q, vt, elements).sum(), q)
         d.append((g[0] @ n).item())
-    assert abs(d[0] - d[1] - 1.0) < 1e-5
+    return d[0] - d[1]
 
 
 def test_segment_strip_2d_gives_corner_crease():
@@ -117,15 +122,8 @@ def test_segment_strip_2d_gives_corner_crease():
     h = 0.2 / np.sqrt(2)
     assert np.allclose(v[0], [1 - h] * 2) and np.allclose(v[-1], [1 + h] * 2)
     # across the bisector near the corner the feature function kinks (jump 1)
-    p = torch.tensor([1.05, 1.05], dtype=D)
-    n = torch.tensor([1.0, -1.0], dtype=D) / np.sqrt(2)
-    vt = torch.tensor(v, dtype=D)
-    d = []
-    for sg in (1.0, -1.0):
-        q = (p + sg * 1e-8 * n).reshape(1, 2).clone().requires_grad_(True)
-        (g,) = torch.autograd.grad(feature_function(q, vt, s).sum(), q)
-        d.append((g[0] @ n).item())
-    assert abs(d[0] - d[1] - 1.0) < 1e-5
+    n = np.array([1.0, -1.0]) / np.sqrt(2)
+    assert abs(_normal_jump(v, s, [1.05, 1.05], n) - 1.0) < 1e-5
 
 
 def test_crease_refine_smoke_and_determinism():
