@@ -482,6 +482,8 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
                     else:
                         vals["eik"] = eikonal_loss(g_s, cfg.sigma)
                         pts, gv = x_s, g_s
+                    if cfg.splat_volume:
+                        pts, gv = torch.cat([pts, x_v]), torch.cat([gv, g_sv[cfg.n_stroke:]])
                     normalize = full and k >= int(cfg.normalize_from * n_steps)
                     last = k == n_steps - 1
                     do_solve = (k % cfg.poisson_every == 0) or last or state["lam"] is None

@@ -78,21 +78,28 @@ class FlowConfig:
         Steps fitting g to the gradient of a sphere around the strokes before
         the initialisation stage (0 = plain SIREN initialisation, as the paper
         text; the published code uses a sphere initialisation).
+    splat_volume : bool
+        Also splat g at the volume samples into the Poisson right-hand side, so
+        that f follows g away from the surface too (the paper splats stroke and
+        surface samples only, Sec. 5.1; without the volume samples the zero set
+        can escape through the periodic box where no stroke holds it, e.g. a
+        capped cylinder becomes an infinite tube). Off by default: it did not
+        close that tube in our tests (the smoothness term itself prefers it).
     dtype : str
         ``"float32"`` or ``"float64"``.
     """
 
     res: int = 128
     padding: float = 0.2
-    width: int = 128
-    hidden_layers: int = 3
+    width: int = 96
+    hidden_layers: int = 2
     omega_0: float = 30.0
-    n_stroke: int = 5000
-    n_surface: int = 5000
-    n_volume: int = 4000
-    init_steps: int = 100
-    steps: int = 300
-    lr: float = 1e-4
+    n_stroke: int = 3000
+    n_surface: int = 2500
+    n_volume: int = 1500
+    init_steps: int = 60
+    steps: int = 200
+    lr: float = 2e-4
     grad_clip: float = 10.0
     w_align: float = 1.0
     w_smooth: float = 0.01
@@ -107,6 +114,7 @@ class FlowConfig:
     smooth_mode: str = "jet"
     prefit_steps: int = 150
     geometric_init_steps: int = 100
+    splat_volume: bool = False
     dtype: str = "float32"
 
     def as_dict(self) -> dict:
