@@ -222,7 +222,11 @@ def _contacts(samples, tol, h, st, opts):
     long_run = ((a1 - a0) >= lo) & ((b1 - b0) >= lo)
     # two strokes that continue each other with a short overlap (end inside end)
     end_to_end = end_a & end_b & ((a1 - a0) >= tol) & ((b1 - b0) >= tol)
-    overlap = (long_run | end_to_end) & (mean_cos >= np.cos(np.radians(opts.overdraw_angle)))
+    # a short stroke drawn (mostly) over a part of another one
+    covered = (((a1 - a0) >= 0.8 * lengths[sa]) | ((b1 - b0) >= 0.8 * lengths[sb])) & (
+        (a1 - a0) >= 2.0 * tol) & ((b1 - b0) >= 2.0 * tol)
+    overlap = (long_run | end_to_end | covered) & (
+        mean_cos >= np.cos(np.radians(opts.overdraw_angle)))
     return {"a": sa, "b": sb, "i": i[bi], "j": j[bi], "a0": a0, "a1": a1,
             "b0": b0, "b1": b1, "overlap": overlap, "dist": dist[bi]}
 
