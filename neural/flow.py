@@ -41,6 +41,12 @@ Engineering choices (documented deviations / gap fills)
 * Ctrl-C (KeyboardInterrupt) stops the loop; the surface of the last completed
   Poisson solve that crosses zero ("the best so far") is returned with
   ``report["interrupted"] = True``.
+* In the full stage the Eikonal term uses surface *and* stroke samples (the
+  paper names S; strokes lie on the surface too, and the published code does
+  the same).
+* Known limitation: a zero set may leave through the periodic box where no
+  stroke holds it (a capped cylinder whose caps carry no strokes becomes an
+  open tube: the smoothness term prefers it); such surfaces are not watertight.
 * Final mesh: pieces of the zero set with no stroke within 4 grid cells are
   dropped (spurious level-set components of the periodic f).
 
@@ -222,11 +228,15 @@ def sample_surface_marching_cubes(f_grid, n: int, rng: np.random.Generator):
     V, Fc = marching_cubes_world(f_grid.detach().cpu().numpy(), np.full(3, 0.5 / res), 1.0 / res)
     if len(Fc) == 0:
         return None
-    tri = V[Fc]
+    return _sample_triangles(V[Fc], n, rng)
+
+
+def _sample_triangles(tri, n, rng):
+    """``n`` area-uniform points on triangles ``tri`` (T, 3, 3), or None if all degenerate."""
     area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
     if not area.sum() > 0:
         return None
-    k = rng.choice(len(Fc), size=n, p=area / area.sum())
+    k = rng.choice(len(tri), size=n, p=area / area.sum())
     r1, r2 = rng.random((2, n))
     s = np.sqrt(r1)
     w = np.stack([1 - s, s * (1 - r2), s * r2], 1)
@@ -258,12 +268,9 @@ def _prefit_targets(init_mesh, frame: Frame, sigma, rng, n=20000):
     F = np.asarray(init_mesh[1], dtype=np.int64)
     if V.ndim != 2 or V.shape[1] != 3 or F.ndim != 2 or F.shape[1] != 3 or len(F) == 0:
         raise ValueError("init_mesh must be (vertices (V, 3), faces (F, 3)) with F >= 1")
-    tri = V[F]
-    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
-    k = rng.choice(len(F), size=n // 2, p=area / area.sum())
-    r1, r2 = rng.random((2, n // 2))
-    s = np.sqrt(r1)
-    surf = np.einsum("nk,nkd->nd", np.stack([1 - s, s * (1 - r2), s * r2], 1), tri[k])
+    surf = _sample_triangles(V[F], n // 2, rng)
+    if surf is None:
+        raise ValueError("init_mesh has only degenerate faces")
     near = surf + rng.normal(scale=0.02, size=surf.shape)
     vol = rng.random((n - n // 2, 3))
     P = np.clip(np.vstack([near, vol]), 0.0, 1.0)
