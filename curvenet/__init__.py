@@ -1,7 +1,9 @@
 """curvenet: 3D sketches and curve networks to surfaces.
 
 The public API is re-exported here. Submodules are imported on first use, so
-``import curvenet`` is fast and never imports torch.
+``import curvenet`` is fast and never imports torch. Snapping is
+``curvenet.snap.snap(sketch)`` (a name shared by a submodule cannot be
+re-exported safely: importing the submodule rebinds the package attribute).
 """
 
 from __future__ import annotations
@@ -21,7 +23,6 @@ _LAZY = {
     "read_sketch": "io",
     "write_sketch": "io",
     "write_network_obj": "io",
-    "snap": "snap",
     "SnapOptions": "snap",
     "find_patches": "cycles",
     "PatchSession": "session",
