@@ -266,8 +266,18 @@ def _stroke_graph(strokes, tol):
     return ids.reshape(-1, 2)
 
 
+def _extend(p, length):
+    """Polyline extended at both ends by ``length`` along its end tangents."""
+    if length <= 0:
+        return p
+    a = _unit(p[0] - p[min(2, len(p) - 1)])
+    b = _unit(p[-1] - p[max(len(p) - 3, 0)])
+    return np.concatenate([[p[0] + length * a], p, [p[-1] + length * b]])
+
+
 def crease_feature_set(strokes, vertices, faces, *, width: float, spacing: float,
-                       guide_radius: float, junction_tol: float | None = None):
+                       guide_radius: float, junction_tol: float | None = None,
+                       extend: float | None = None):
     """Strips along crease strokes, guided by the surface, split into channels.
 
     Parameters
@@ -283,6 +293,10 @@ def crease_feature_set(strokes, vertices, faces, *, width: float, spacing: float
         Neighbourhood of :func:`stroke_guides_from_mesh`.
     junction_tol : float, optional
         Stroke ends closer than this meet at a junction (default ``2 * spacing``).
+    extend : float, optional
+        Each stroke is prolonged by this much along its end tangents (default ``width``):
+        the gradient of a feature function is log-singular on the strip's border dM, so the
+        strip's ends must not cross the surface at corners or at gaps of split strokes.
 
     Returns
     -------
@@ -299,7 +313,8 @@ def crease_feature_set(strokes, vertices, faces, *, width: float, spacing: float
     vs, ts, cs = [], [], []
     base = 0
     for k, s in enumerate(strokes):
-        p = _resample(np.asarray(s, dtype=np.float64), spacing)
+        p = _resample(_extend(np.asarray(s, dtype=np.float64),
+                              width if extend is None else extend), spacing)
         if len(p) < 2:
             continue
         ge = stroke_guides_from_mesh(p, vertices, faces, radius=guide_radius)
