@@ -15,6 +15,14 @@ the dihedral angles across the crease strokes; writes ``benchmarks/results/box_c
 The input surface is a rounded box (marching cubes of a box SDF rounded by 0.05, standing in
 for a rounded neural fit), the flow-aligned fit of ``neural.flow`` (``--input flow``), or the
 true box (``--input true``).
+
+Measured (shared, overloaded 2-core CPU, 1 thread): feature function 100k points x 1992
+triangles: global 86.0 s / 1227 MB vs mollified 3.8 s / 607 MB (forward; 22.8x time); with
+the gradient on 10k points: 48.9 s / 7038 MB vs 1.2 s / 288 MB (40x time, 24x memory).
+Box (rounded input, softplus, 1200 steps, 128^3): normal error 4.01 deg without the strips vs
+3.93 deg with them (target "halved" missed: the plain softplus(100) fit of the sharp
+point-to-plane targets is already sharp, both errors are dominated by face waviness);
+median dihedral angle 89.2 / 88.3 deg, worst stroke within 3.2 / 2.7 deg of 90.
 """
 
 from __future__ import annotations
