@@ -618,8 +618,11 @@ def crease_refine(vertices, faces, strokes, labels=None, *, quality: str = "draf
         for s in range(0, len(xt), 20000):
             xc = xt[s:s + 20000].clone().requires_grad_(True)
             fv = feats(xc)  # (B, C)
-            g = torch.stack([torch.autograd.grad(fv[:, c].sum(), xc, retain_graph=True)[0]
-                             for c in range(fv.shape[1])], 1)  # (B, C, 3)
+            if fv.requires_grad:
+                g = torch.stack([torch.autograd.grad(fv[:, c].sum(), xc, retain_graph=True)[0]
+                                 for c in range(fv.shape[1])], 1)  # (B, C, 3)
+            else:  # no strip element near any point of this chunk: f = 0, grad f = 0
+                g = torch.zeros(fv.shape + (3,), dtype=fv.dtype)  # (B, C, 3)
             fs.append(fv.detach())
             gs.append(g.detach())
         return (xt.to(dev, dtype), torch.cat(fs).to(dev, dtype), torch.cat(gs).to(dev, dtype))

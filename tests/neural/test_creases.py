@@ -157,3 +157,13 @@ def test_crease_refine_invalid_input():
         crease_refine(v, f, [np.zeros((1, 3))], ["crease"])
     with pytest.raises(ValueError, match="device"):
         crease_refine(v, f, s, ["crease"], device="tpu")
+
+
+def test_crease_refine_with_a_stroke_far_from_the_surface():
+    # no strip element near any surface sample: those samples get f = 0 and grad f = 0
+    # (regression: autograd used to fail on a chunk with no neighbour pairs)
+    v, f = _box_mesh()
+    far = [np.stack([np.full(10, 3.0), np.linspace(0, 1, 10), np.zeros(10)], 1)]
+    r = crease_refine(v, f, far, ["crease"], steps=3, res=16, pool=2000, batch=200, hidden=8,
+                      layers=1, progress=False)
+    assert r.report["n_strip_triangles"] > 0 and np.isfinite(r.report["final_loss"])
