@@ -1,8 +1,8 @@
 """End-to-end checks of the flow-aligned neural surfacing driver (Zhang et al. 2025).
 
 The small tests use a tiny configuration (seconds); the analytic-shape F-score
-checks of the issue run the real ``draft`` preset and are heavy: only the
-sphere, at a reduced budget, runs in CI; the others are marked ``slow``.
+checks of the issue run the real ``draft`` preset and are heavy: all are
+marked ``slow`` (the CI keeps the tiny end-to-end runs).
 """
 
 import numpy as np
@@ -124,8 +124,10 @@ def _fit_and_score(name, **kw):
     return r, f, cd
 
 
+@pytest.mark.slow
 def test_rough_sphere_draft_reduced_budget():
-    # CI budget: the draft preset with fewer steps; the full draft is in the slow test below
+    # the draft preset with fewer steps; measured 350-420 s on the shared 2-core machine
+    # under load (about 25 s alone), too heavy for CI, hence slow as well
     r, f, cd = _fit_and_score("sphere", init_steps=30, steps=50)
     assert f >= 0.85, (f, cd)
 
