@@ -14,6 +14,14 @@ reference  ``default`` on an 18-stroke rough sphere: time, peak memory, F-score,
            13.8 GB, F 99.8 %, Chamfer 2.6e-3)
 vns        ``draft`` time per sketch on several vns sketches, PNG previews under /tmp
 
+Measured 2026-11-24 on the shared 2-core CPU (load average 3-7 from other engineers;
+alone, draft takes ~12-16 s per sketch, as phone_flowrep/trebol show):
+draft100 gamepad (108 strokes) 238 s; vns draft: bulbasaur 571 s (under load),
+phone_flowrep 16.3 s, trebol_flowrep 15.7 s; s/step full stage: default 10.0 (128^3),
+29.6 (256^3); paper 62.6 (128^3), 42.9 (256^3) (2-step runs, first-step overhead
+and load included); reference sphere (18 strokes), default: 590 s, 1.01 GB,
+F 0.833, Chamfer 5.2e-3 vs published code 1320 s, 13.8 GB, F 0.998, 2.6e-3.
+
 Each measurement runs in a fresh subprocess so that peak memory (ru_maxrss) is its own.
 The machine is shared: note the load average printed with the table.
 """
