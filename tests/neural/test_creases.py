@@ -21,14 +21,6 @@ from neural.sharpnet import boundary_triples
 D = torch.float64
 
 
-@pytest.fixture(autouse=True)
-def _one_thread():
-    n = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(n)
-
-
 def _box_mesh():
     # unit box [0, 1]^3, subdivided so that faces near an edge exist on both sides
     m = trimesh.creation.box(extents=(1, 1, 1))

@@ -7,7 +7,6 @@ marked ``slow`` (the CI keeps the tiny end-to-end runs).
 
 import numpy as np
 import pytest
-import torch
 
 from neural import flow
 from neural.flow import fit_flow_surface
@@ -23,14 +22,6 @@ def _circles(n=64, r=1.0):
     z = 0 * t
     return [np.c_[r * np.cos(t), r * np.sin(t), z], np.c_[r * np.cos(t), z, r * np.sin(t)],
             np.c_[z, r * np.cos(t), r * np.sin(t)]]
-
-
-@pytest.fixture(autouse=True)
-def _threads():
-    n = torch.get_num_threads()
-    torch.set_num_threads(2)
-    yield
-    torch.set_num_threads(n)
 
 
 def test_result_fields_and_world_coordinates():

@@ -22,15 +22,6 @@ from neural.sharpnet import (
 D = torch.float64
 
 
-@pytest.fixture(autouse=True)
-def _one_thread():
-    # the CI machine has 2 shared cores; torch's thread pool thrashes under load
-    n = torch.get_num_threads()
-    torch.set_num_threads(1)
-    yield
-    torch.set_num_threads(n)
-
-
 def test_positional_encoding():
     x = torch.tensor([[0.25, -0.5]], dtype=D)
     z = positional_encoding(x, 2)
