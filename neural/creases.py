@@ -33,6 +33,8 @@ from dataclasses import asdict, dataclass, fields, replace
 import numpy as np
 from scipy.spatial import cKDTree
 
+from ._inputs import check_strokes
+
 __all__ = [
     "CreaseConfig",
     "CreaseResult",
@@ -471,17 +473,7 @@ def _check_inputs(vertices, faces, strokes, labels):
     if f.ndim != 2 or f.shape[1] != 3 or len(f) == 0 or f.min() < 0 or f.max() >= len(v):
         raise ValueError(f"faces must be a non-empty (F, 3) index array into vertices, "
                          f"got shape {f.shape}")
-    st = [np.asarray(s, dtype=np.float64) for s in strokes]
-    for i, s in enumerate(st):
-        if s.ndim != 2 or s.shape[1] != 3 or len(s) < 2 or not np.isfinite(s).all():
-            raise ValueError(f"strokes[{i}] must be a finite (n >= 2, 3) array, got {s.shape}")
-    lab = list(labels) if labels is not None else ["crease"] * len(st)
-    if len(lab) != len(st):
-        raise ValueError(f"labels must have one entry per stroke ({len(st)}), got {len(lab)}")
-    for i, x in enumerate(lab):
-        if x not in ("boundary", "crease", "construction"):
-            raise ValueError(f"labels[{i}] must be 'boundary', 'crease' or 'construction', "
-                             f"got {x!r}")
+    st, lab = check_strokes(list(strokes), labels, allow_empty=True)
     return v, f, st, lab
 
 

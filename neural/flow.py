@@ -63,6 +63,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ._inputs import check_strokes
 from .presets import FlowConfig, get_config
 
 __all__ = ["FlowResult", "fit_flow_surface", "StrokeSampler", "sample_surface_cells",
@@ -283,25 +284,7 @@ def _prefit_targets(init_mesh, frame: Frame, sigma, rng, n=20000):
 
 
 def _check_strokes(strokes, labels):
-    if not isinstance(strokes, (list, tuple)) or len(strokes) == 0:
-        raise ValueError("strokes must be a non-empty list of (n, 3) arrays")
-    out = []
-    for i, s in enumerate(strokes):
-        a = np.asarray(s, dtype=np.float64)
-        if a.ndim != 2 or a.shape[1] != 3 or len(a) < 2:
-            raise ValueError(f"strokes[{i}] must have shape (n >= 2, 3), got {a.shape}")
-        if not np.isfinite(a).all():
-            raise ValueError(f"strokes[{i}] contains non-finite coordinates")
-        out.append(a)
-    if labels is None:
-        labels = ["crease"] * len(out)
-    labels = list(labels)
-    if len(labels) != len(out):
-        raise ValueError(f"labels has {len(labels)} entries for {len(out)} strokes")
-    for i, lab in enumerate(labels):
-        if lab not in ("boundary", "crease", "construction"):
-            raise ValueError(f"labels[{i}] must be 'boundary', 'crease' or 'construction', "
-                             f"got {lab!r}")
+    out, labels = check_strokes(strokes, labels)
     keep = [i for i, lab in enumerate(labels) if lab != "construction"]
     if not keep:
         raise ValueError("all strokes are construction strokes; nothing to surface")
