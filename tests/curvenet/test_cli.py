@@ -106,3 +106,13 @@ def test_import_curvenet_and_patches_do_not_import_torch(box_obj, tmp_path):
             "sys.exit(3 if 'torch' in sys.modules else 0)")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert r.returncode == 0, r.stderr
+
+
+def test_outputs_get_ordinary_permissions(tmp_path, box_obj):
+    import os
+    import stat
+    out = tmp_path / "net.json"
+    assert main(["snap", str(box_obj), "-o", str(out)]) == 0
+    mask = os.umask(0)
+    os.umask(mask)
+    assert stat.S_IMODE(out.stat().st_mode) == 0o666 & ~mask
