@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .cycles import orient_patches
 from .network import CurveNetwork
 from .sketch import Sketch
 
@@ -95,61 +96,12 @@ def _trimesh(vertices, faces):
     return trimesh.Trimesh(np.asarray(vertices, float), np.asarray(faces, np.int64), process=True)
 
 
-def _loop_points(net: CurveNetwork, loop) -> np.ndarray:
-    """Points of an oriented loop, each edge without its last point, ``(k, 3)``."""
-    parts = [(net.edges[e].curve if fwd else net.edges[e].curve[::-1])[:-1] for e, fwd in loop]
-    return np.concatenate(parts)
+def _orient(net: CurveNetwork, faces) -> list:
+    """Consistently oriented loops, closed surfaces outward.
 
-
-def _signed_volume(net: CurveNetwork, faces) -> float:
-    """Signed volume enclosed by the loops, each fan-triangulated around its centroid."""
-    vol = 0.0
-    for loop in faces:
-        p = _loop_points(net, loop)
-        c = p.mean(axis=0)
-        q = np.roll(p, -1, axis=0)
-        vol += np.einsum("ij,ij->", np.cross(p - c, q - c), np.broadcast_to(c, p.shape)) / 6.0
-    return vol
-
-
-def _orient_consistently(net: CurveNetwork, faces) -> list:
-    """Flip loops so that faces sharing a 2-face edge walk it in opposite directions.
-
-    Breadth-first propagation over edges used by exactly two faces; edges used
-    by three or more (non-manifold) do not propagate.
+    See :func:`curvenet.cycles.orient_patches`.
     """
-    faces = [list(f) for f in faces]
-    users: dict = {}
-    for fi, loop in enumerate(faces):
-        for e, _ in loop:
-            users.setdefault(e, []).append(fi)
-    done = [False] * len(faces)
-    for start in range(len(faces)):
-        if done[start]:
-            continue
-        done[start] = True
-        queue = [start]
-        while queue:
-            fi = queue.pop()
-            for e, fwd in faces[fi]:
-                if len(users[e]) != 2:
-                    continue
-                other = users[e][0] if users[e][1] == fi else users[e][1]
-                if done[other]:
-                    continue
-                ofwd = dict(faces[other])[e]
-                if ofwd == fwd:
-                    faces[other] = [(x, not d) for x, d in reversed(faces[other])]
-                done[other] = True
-                queue.append(other)
-    return faces
-
-
-def _outward(net: CurveNetwork, faces) -> list:
-    faces = _orient_consistently(net, faces)
-    if _signed_volume(net, faces) < 0:
-        faces = [[(e, not d) for e, d in reversed(loop)] for loop in faces]
-    return faces
+    return orient_patches(net, [[e for e, _ in loop] for loop in faces])
 
 
 def _polygon_mesh(points_per_face):
@@ -183,7 +135,7 @@ def _polyhedron(name, vertices, vertex_faces, *, samples, crease=True, closed=Tr
                                         label="crease" if crease else "boundary")
             loop.append((ids[key], a == key[0]))
         faces.append(loop)
-    faces = _outward(net, faces) if closed else _orient_consistently(net, faces)
+    faces = _orient(net, faces)
     polys = [vertices[list(c)] for c in vertex_faces]
     return AnalyticShape(name, net, faces, closed, 0, lambda _s: _polygon_mesh(polys))
 
@@ -228,7 +180,7 @@ def grid_box(n: int = 1, *, size=(1.0, 1.0, 1.0), samples: int = 33) -> Analytic
                         c[axis], c[a1], c[a2] = side, i + di, j + dj
                         corners.append(tuple(c))
                     faces.append([edge(corners[k], corners[(k + 1) % 4]) for k in range(4)])
-    faces = _outward(net, faces)
+    faces = _orient(net, faces)
 
     def reference(_s):
         import trimesh
@@ -342,7 +294,7 @@ def _param_shape(name, F, nu, nv, *, periodic_u, poles, samples, closed, genus, 
     if caps:
         faces.append([edge("u", i, 0) for i in range(nu)])
         faces.append([(edge("u", i, nv)[0], True) for i in range(nu)])
-    faces = _outward(net, faces) if closed else _orient_consistently(net, faces)
+    faces = _orient(net, faces)
     return AnalyticShape(name, net, faces, closed, genus, reference)
 
 
