@@ -80,6 +80,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="continue the classical result with the neural flow-alignment fit")
     s.add_argument("--quality", choices=("draft", "default", "paper"), default="draft")
     s.add_argument("--device", default="cpu", help="cpu or cuda (neural route)")
+    s.add_argument("--closed-box", action="store_true",
+                   help="neural: f = outside on the box walls, so the surface closes "
+                        "inside the box (default: the paper's periodic box)")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--preview", metavar="PNG", help="write a picture of the result")
     s.add_argument("--up", choices=("x", "y", "z"), default="z", help="up axis of the preview")
@@ -141,7 +144,8 @@ def _surface_one(inp: str, out: str, args) -> dict:
                       close=args.close, surfacer=args.surfacer, subdiv=args.subdiv,
                       resolution=args.resolution, crease_angle=args.crease_angle,
                       refine=args.refine, quality=args.quality, device=args.device,
-                      seed=args.seed, progress=not args.no_progress)
+                      seed=args.seed, progress=not args.no_progress,
+                      neural_options={"boundary": "dirichlet"} if args.closed_box else None)
         res.save(out)
         if args.preview:
             from .preview import render_preview

@@ -47,6 +47,10 @@ Engineering choices (documented deviations / gap fills)
 * Known limitation: a zero set may leave through the periodic box where no
   stroke holds it (a capped cylinder whose caps carry no strokes becomes an
   open tube: the smoothness term prefers it); such surfaces are not watertight.
+  ``boundary="dirichlet"`` closes them inside the box, but not at the rims (see
+  :class:`neural.presets.FlowConfig`). A minimal-area term (first variation of
+  the zero set's area through f) and a wall penalty were tried and did not
+  move the closure to the rims within the draft budget.
 * Final mesh: pieces of the zero set with no stroke within 4 grid cells are
   dropped (spurious level-set components of the periodic f).
 
@@ -380,7 +384,8 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
     if init_mesh is None and cfg.geometric_init_steps > 0:
         _geometric_init(net, sampler, cfg, gen)
     opt = torch.optim.Adam(net.parameters(), lr=cfg.lr)
-    solver = PoissonSolver(res, device=dev, dtype=dtype, smooth_cells=cfg.smooth_cells)
+    solver = PoissonSolver(res, device=dev, dtype=dtype, smooth_cells=cfg.smooth_cells,
+                           boundary=cfg.boundary)
 
     stages = []
     if init_mesh is not None:

@@ -82,6 +82,24 @@ def test_refine_from_init_mesh():
     assert r.report["steps"] == {"prefit": 5, "full": 4}
 
 
+def test_dirichlet_boundary_keeps_walls_outside():
+    r = fit_flow_surface(_circles(), progress=False, boundary="dirichlet", **TINY)
+    f = r.f_grid
+    walls = np.concatenate([f[0].ravel(), f[-1].ravel(), f[:, 0].ravel(), f[:, -1].ravel(),
+                            f[:, :, 0].ravel(), f[:, :, -1].ravel()])
+    assert (walls > 0).all()
+
+
+@pytest.mark.slow
+def test_dirichlet_boundary_closes_capped_cylinder():
+    # periodic: the capless cylinder leaves through the box walls (not watertight);
+    # dirichlet: it closes inside the box (genus 0), though not at the rims
+    import trimesh
+    r, f, cd = _fit_and_score("capped_cylinder", boundary="dirichlet")
+    m = trimesh.Trimesh(r.vertices, r.faces)
+    assert m.is_watertight and m.euler_number == 2
+
+
 @pytest.mark.parametrize("kw,match", [
     (dict(strokes=[]), "strokes"),
     (dict(strokes=[np.zeros((1, 3))]), r"strokes\[0\]"),
