@@ -48,7 +48,9 @@ class FlowConfig:
         longest side (paper: 0.2, Sec. 4.4.1).
     boundary : str
         ``"periodic"`` (the paper: the padded box is a 3-torus) or ``"dirichlet"``
-        (f = 0 on the box walls, solved by odd extension at 8x the FFT cost). On
+        (f = 0 on the box walls, solved by odd extension at 8x the FFT size: one
+        solve takes 0.04 s vs 0.005 s at 64^3, 1.3 s vs 0.03 s at 128^3 and 11 s /
+        9.3 GB vs 1 s / 1.5 GB at 256^3 on 2 CPU cores, so it suits draft). On
         the torus a zero set may close by wrapping around the box where no stroke
         holds it: the rough capped cylinder, whose caps carry no strokes, comes
         out as a tube through the walls (not watertight; F-score 0.64 at draft).
