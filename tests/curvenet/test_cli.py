@@ -116,3 +116,21 @@ def test_outputs_get_ordinary_permissions(tmp_path, box_obj):
     mask = os.umask(0)
     os.umask(mask)
     assert stat.S_IMODE(out.stat().st_mode) == 0o666 & ~mask
+
+
+@pytest.mark.parametrize("flag,expected", [((), None),
+                                           (("--closed-box",), {"boundary": "dirichlet"})])
+def test_closed_box_flag_reaches_the_neural_fit(tmp_path, box_obj, monkeypatch, flag, expected):
+    import curvenet.pipeline as pipeline
+    seen = {}
+    real = pipeline.surface
+
+    def spy(*args, **kw):
+        seen.update(kw)
+        return real(*args, **{**kw, "method": "classical"})
+    monkeypatch.setattr(pipeline, "surface", spy)
+    out = tmp_path / "m.obj"
+    assert main(["surface", str(box_obj), "-o", str(out), "--method", "neural",
+                 "--no-progress", *flag]) == 0
+    assert seen["method"] == "neural" and seen["neural_options"] == expected
+    assert out.exists()
