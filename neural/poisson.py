@@ -156,8 +156,8 @@ class PoissonSolver:
         (0 = the exact Eq. 10).
     boundary : {"periodic", "dirichlet"}
         ``"periodic"``: the unit cube is a 3-torus (Eq. 8-10). ``"dirichlet"``:
-        f = 0 on the cube's walls, by the odd extension of f across each wall
-        (a periodic solve on a doubled grid, 8x the FFT work).
+        f = 0 on the cube's walls: f in sines, exact projections by dense
+        per-axis transforms (:meth:`_solve_sine`).
 
     Notes
     -----
@@ -180,7 +180,11 @@ class PoissonSolver:
         if boundary not in ("periodic", "dirichlet"):
             raise ValueError(f"boundary must be 'periodic' or 'dirichlet', got {boundary!r}")
         self.res, self.boundary = int(res), boundary
-        n = self.res if boundary == "periodic" else 2 * self.res
+        self.device, self.dtype = device, dtype
+        if boundary == "dirichlet":
+            self._init_sine(smooth_cells)
+            return
+        n = self.res
         u = torch.fft.fftfreq(n, d=1.0 / n, dtype=torch.float64)
         ur = torch.fft.rfftfreq(n, d=1.0 / n, dtype=torch.float64)
         if n % 2 == 0:                       # no real Nyquist mode for a derivative
@@ -199,7 +203,31 @@ class PoissonSolver:
         op = torch.stack([(ux * inv).expand(n, n, -1), (uy * inv).expand(n, n, -1),
                           (uz * inv).expand(n, n, -1)])
         self._op = op.to(device=device, dtype=dtype).contiguous()
-        self.device, self.dtype = device, dtype
+
+    def _init_sine(self, smooth_cells: float) -> None:
+        """Bases of the Dirichlet solve: f = sum_k a_k prod_axes sin(pi k x), k = 1..n.
+
+        Nodes sit at ``x_i = (i + 1/2) / n``, where the sine modes ``k = 1..n``
+        (DST-II) and the cosine modes ``k = 0..n-1`` (DCT-II) are discretely
+        orthogonal, so projections are exact. ``d/dx`` maps sine mode k to k pi
+        times cosine mode k; cosine mode n does not exist (its row is zero).
+        """
+        n = self.res
+        i = torch.arange(n, dtype=torch.float64) + 0.5
+        k = torch.arange(1, n + 1, dtype=torch.float64)
+        S = torch.sin(math.pi * k[:, None] * i[None] / n)                 # (n modes, n nodes)
+        C = torch.cos(math.pi * k[:-1, None] * i[None] / n)               # modes 1..n-1
+        Cp = torch.cat([C / (C * C).sum(1, keepdim=True), torch.zeros(1, n, dtype=torch.float64)])
+        kk = k.view(n, 1, 1) ** 2 + k.view(1, n, 1) ** 2 + k.view(1, 1, n) ** 2
+        inv = 1.0 / (math.pi * kk)
+        if smooth_cells > 0:    # sine mode k has k / 2 cycles per unit length
+            s = smooth_cells / n
+            inv = inv * torch.exp(-2.0 * math.pi ** 2 * s * s * kk / 4.0)
+
+        def put(t):
+            return t.to(device=self.device, dtype=self.dtype).contiguous()
+        self._synth, self._sin_proj = put(S.T), put(S / (S * S).sum(1, keepdim=True))
+        self._cos_proj, self._k, self._inv = put(Cp), put(k), put(inv)
 
     def solve(self, g_grid: torch.Tensor) -> torch.Tensor:
         """Integrate a gradient grid.
@@ -217,18 +245,34 @@ class PoissonSolver:
             raise ValueError(f"g_grid must have shape (3, {n}, {n}, {n}), "
                              f"got {tuple(g_grid.shape)}")
         if self.boundary == "dirichlet":
-            # odd extension of f across each wall (f = 0 there): g's component along
-            # the axis is mirrored evenly, the other two oddly; the doubled box is
-            # mapped to the unit cube, which doubles the gradient
-            sign = torch.tensor([1.0, -1.0, -1.0], dtype=g_grid.dtype, device=g_grid.device)
-            for a in range(3):
-                s = torch.roll(sign, a).view(3, 1, 1, 1)
-                g_grid = torch.cat([g_grid, s * torch.flip(g_grid, (a + 1,))], a + 1)
-            return self._spectral(2.0 * g_grid)[:n, :n, :n]
+            return self._solve_sine(g_grid)
         return self._spectral(g_grid)
 
+    def _solve_sine(self, g_grid: torch.Tensor) -> torch.Tensor:
+        """``Laplace f = div g`` with f = 0 on the walls, in the sine basis.
+
+        g's component a is projected on cosines along axis a and sines along the
+        others; then ``a_k = sum_a k_a G_a(k) / (pi |k|^2)`` and f is synthesised
+        from the sines. Dense (n, n) transforms per axis: O(n^4), exact, on any
+        device, with autograd.
+        """
+        n = self.res
+
+        def along(M, x, axis):
+            return torch.movedim(torch.tensordot(M, torch.movedim(x, axis, 0), dims=1), 0, axis)
+        acc = 0.0
+        for a in range(3):
+            G = g_grid[a]
+            for ax in range(3):
+                G = along(self._cos_proj if ax == a else self._sin_proj, G, ax)
+            acc = acc + self._k.view([n if d == a else 1 for d in range(3)]) * G
+        f = acc * self._inv
+        for ax in range(3):
+            f = along(self._synth, f, ax)
+        return f
+
     def _spectral(self, g_grid: torch.Tensor) -> torch.Tensor:
-        m = g_grid.shape[-1]
-        gh = torch.fft.rfftn(g_grid, dim=(-3, -2, -1))           # (3, m, m, m//2+1)
+        n = self.res
+        gh = torch.fft.rfftn(g_grid, dim=(-3, -2, -1))           # (3, n, n, n//2+1)
         fh = 1j * (self._op * gh).sum(0)
-        return torch.fft.irfftn(fh, s=(m, m, m), dim=(-3, -2, -1))
+        return torch.fft.irfftn(fh, s=(n, n, n), dim=(-3, -2, -1))

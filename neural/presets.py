@@ -48,17 +48,17 @@ class FlowConfig:
         longest side (paper: 0.2, Sec. 4.4.1).
     boundary : str
         ``"periodic"`` (the paper: the padded box is a 3-torus) or ``"dirichlet"``
-        (f = 0 on the box walls, solved by odd extension at 8x the FFT size: one
-        solve takes 0.04 s vs 0.005 s at 64^3, 1.3 s vs 0.03 s at 128^3 and 11 s /
-        9.3 GB vs 1 s / 1.5 GB at 256^3 on 2 CPU cores, so it suits draft). On
+        (f = 0 on the box walls, a sine series: one solve takes 0.01 s vs 0.007 s
+        at 64^3, 0.11 s vs 0.05 s at 128^3 and 2.8-3.9 s vs 0.6-0.7 s at 256^3 on
+        2 CPU cores, with less memory than the FFT). On
         the torus a zero set may close by wrapping around the box where no stroke
         holds it: the rough capped cylinder, whose caps carry no strokes, comes
         out as a tube through the walls (not watertight; F-score 0.64 at draft).
         ``"dirichlet"`` makes the walls outside, so every surface closes inside
         the box: the same cylinder becomes watertight with genus 0, but its ends
-        close as domes in the padding (F-score 0.54, Chamfer 0.040 vs 0.046, 2x
-        the time at draft); nothing in the energy puts the closure at the rims.
-        Other rough shapes at draft, dirichlet vs periodic: sphere 0.989 vs 0.994,
+        close as domes in the padding (F-score 0.54, Chamfer 0.040 vs 0.046, 17 s
+        vs 13 s at draft); nothing in the energy puts the closure at the rims.
+        Other rough shapes at draft, dirichlet vs periodic: sphere 0.992 vs 0.996,
         ellipsoid 0.993 vs 0.978, torus 0.881 vs 0.953; rough box normal error
         20.1 vs 27.8 degrees (its faces no longer bulge through the walls).
     width, hidden_layers : int

@@ -61,6 +61,24 @@ def test_dirichlet_solve_recovers_function_zero_on_walls(n):
     assert ((periodic - periodic.mean()) - (f - f.mean())).abs().max() > 1e-2
 
 
+def test_dirichlet_solve_high_modes_and_gradcheck():
+    # a sum of sine modes up to k = n - 1 (the highest with a cosine derivative)
+    n = 12
+    X, Y, Z = _grid(n)
+    p = math.pi
+    f, g = 0.0, 0.0
+    for kx, ky, kz, c in [(1, 1, 1, 1.0), (n - 1, 2, 3, 0.3), (4, n - 1, n - 1, -0.2)]:
+        sx, sy, sz = (torch.sin(k * p * t) for k, t in ((kx, X), (ky, Y), (kz, Z)))
+        cx, cy, cz = (torch.cos(k * p * t) for k, t in ((kx, X), (ky, Y), (kz, Z)))
+        f = f + c * sx * sy * sz
+        g = g + c * p * torch.stack([kx * cx * sy * sz, ky * sx * cy * sz, kz * sx * sy * cz])
+    solver = PoissonSolver(n, dtype=torch.float64, boundary="dirichlet")
+    assert (solver.solve(g) - f).abs().max() < 1e-10
+    small = PoissonSolver(4, dtype=torch.float64, boundary="dirichlet")
+    gg = torch.randn(3, 4, 4, 4, dtype=torch.float64, requires_grad=True)
+    assert torch.autograd.gradcheck(lambda t: small.solve(t).sum(-1), (gg,))
+
+
 def test_solver_rejects_bad_shape():
     with pytest.raises(ValueError, match="g_grid"):
         PoissonSolver(8).solve(torch.zeros(3, 8, 8, 9))
