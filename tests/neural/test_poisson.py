@@ -48,7 +48,7 @@ def test_odd_resolution_and_zero_mean():
 @pytest.mark.parametrize("n", [24, 25])
 def test_dirichlet_solve_recovers_function_zero_on_walls(n):
     # f = sin(pi x) sin(2 pi y) sin(pi z) vanishes on the walls but is not periodic
-    # with period 1; the odd-extension solve recovers it exactly (sine series)
+    # with period 1; the Dirichlet solve recovers it exactly (one sine mode)
     X, Y, Z = _grid(n)
     p = math.pi
     f = torch.sin(p * X) * torch.sin(2 * p * Y) * torch.sin(p * Z)
