@@ -139,6 +139,11 @@ def normalize_scale_shift(f_grid: torch.Tensor, f_strokes: torch.Tensor, *, eps:
     return (f_grid - shift) / scale, (f_strokes - shift) / scale
 
 
+def _along(M: torch.Tensor, x: torch.Tensor, axis: int) -> torch.Tensor:
+    """Apply the matrix ``M`` (m, n) along ``axis`` of the 3D tensor ``x`` (size n there)."""
+    return torch.movedim(torch.tensordot(M, torch.movedim(x, axis, 0), dims=1), 0, axis)
+
+
 class PoissonSolver:
     """Spectral solver of ``Laplace f = div g`` on the periodic unit cube (Eq. 8-10).
 
@@ -257,18 +262,15 @@ class PoissonSolver:
         device, with autograd.
         """
         n = self.res
-
-        def along(M, x, axis):
-            return torch.movedim(torch.tensordot(M, torch.movedim(x, axis, 0), dims=1), 0, axis)
         acc = 0.0
         for a in range(3):
             G = g_grid[a]
             for ax in range(3):
-                G = along(self._cos_proj if ax == a else self._sin_proj, G, ax)
+                G = _along(self._cos_proj if ax == a else self._sin_proj, G, ax)
             acc = acc + self._k.view([n if d == a else 1 for d in range(3)]) * G
         f = acc * self._inv
         for ax in range(3):
-            f = along(self._synth, f, ax)
+            f = _along(self._synth, f, ax)
         return f
 
     def _spectral(self, g_grid: torch.Tensor) -> torch.Tensor:
