@@ -50,10 +50,10 @@ class FlowConfig:
         ``"periodic"`` (the paper: the padded box is a 3-torus) or ``"dirichlet"``
         (f = 0 on the box walls, a sine series: one solve takes 0.01 s vs 0.007 s
         at 64^3, 0.11 s vs 0.05 s at 128^3 and 2.8-3.9 s vs 0.6-0.7 s at 256^3 on
-        2 CPU cores, with less memory than the FFT). On
-        the torus a zero set may close by wrapping around the box where no stroke
-        holds it: the rough capped cylinder, whose caps carry no strokes, comes
-        out as a tube through the walls (not watertight; F-score 0.64 at draft).
+        2 CPU cores, with less memory than the FFT). On the torus a zero set may
+        close by wrapping around the box where no stroke holds it: the rough
+        capped cylinder, whose caps carry no strokes, comes out as a tube through
+        the walls (not watertight; F-score 0.64 at draft).
         ``"dirichlet"`` makes the walls outside, so every surface closes inside
         the box: the same cylinder becomes watertight with genus 0, but its ends
         close as domes in the padding (F-score 0.54, Chamfer 0.040 vs 0.046, 17 s

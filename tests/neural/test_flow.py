@@ -95,7 +95,9 @@ def test_dirichlet_boundary_closes_capped_cylinder():
     # periodic: the capless cylinder leaves through the box walls (not watertight);
     # dirichlet: it closes inside the box (genus 0), though not at the rims
     import trimesh
-    r, f, cd = _fit_and_score("capped_cylinder", boundary="dirichlet")
+    _, sk = _rough_shape_sketch("capped_cylinder")
+    r = fit_flow_surface(sk.strokes, labels=sk.labels, quality="draft", progress=False,
+                         boundary="dirichlet")
     m = trimesh.Trimesh(r.vertices, r.faces)
     assert m.is_watertight and m.euler_number == 2
 
