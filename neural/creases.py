@@ -628,9 +628,11 @@ def crease_refine(vertices, faces, strokes, labels=None, *, quality: str = "draf
 
     net = SharpNet(3, feats, hidden=cfg.hidden, layers=cfg.layers, n_freqs=cfg.n_freqs,
                    activation=cfg.activation,
-                   geometric_init=cfg.geometric_init).to(dev, dtype)
-    if feats is not None:
-        net.features = None  # the pools carry the feature values; restored for extraction
+                   geometric_init=cfg.geometric_init)
+    # the pools carry the feature values; the feature set stays on the host in float64 and
+    # is only used again for extraction (moving it with the network would cast it to float32)
+    net.features = None
+    net = net.to(dev, dtype)
 
     def phi(pool, idx):
         x, f0, g0 = pool
@@ -694,7 +696,6 @@ def crease_refine(vertices, faces, strokes, labels=None, *, quality: str = "draf
 
     # extraction: exact features on the grid
     t1 = time.perf_counter()
-    net.features = feats
     n = cfg.res
     axis = np.linspace(-1.0, 1.0, n)
     grid = np.stack(np.meshgrid(axis, axis, axis, indexing="ij"), -1).reshape(-1, 3)
