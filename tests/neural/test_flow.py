@@ -127,9 +127,9 @@ def _rough_shape_sketch(name, seed=0):
     return shape, sk
 
 
-def _fit_and_score(name, **kw):
+def _fit_and_score(name, quality="draft", **kw):
     shape, sk = _rough_shape_sketch(name)
-    r = fit_flow_surface(sk.strokes, labels=sk.labels, quality="draft", progress=False, **kw)
+    r = fit_flow_surface(sk.strokes, labels=sk.labels, quality=quality, progress=False, **kw)
     ref = shape.reference_mesh(4)
     f, cd = fscore(r.vertices, r.faces, ref.vertices, ref.faces)
     return r, f, cd
