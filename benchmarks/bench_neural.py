@@ -62,13 +62,16 @@ def _worker(spec: dict) -> dict:
         strokes, labels = sk.strokes, sk.labels
     out["strokes"] = len(strokes)
     t = time.perf_counter()
+    device = spec.get("device", "cpu")
     r = fit_flow_surface(strokes, labels=labels, quality=spec["quality"], progress=False,
-                         **spec.get("overrides", {}))
+                         device=device, **spec.get("overrides", {}))
     out["time_s"] = time.perf_counter() - t
     out["timings"] = r.timings
     out["steps"] = r.report["steps"]
     out["faces"] = len(r.faces)
     out["peak_gb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e6
+    if device.startswith("cuda"):
+        out["gpu_peak_gb"] = torch.cuda.max_memory_allocated() / 1e9
     if spec["kind"] == "sphere":
         from tests.neural._metrics import fscore
         ref = shape.reference_mesh(5)
@@ -112,6 +115,14 @@ def _run(spec: dict, timeout: float = 3600) -> dict:
     return json.loads(p.stdout.strip().splitlines()[-1])
 
 
+def _memory(r: dict) -> str:
+    """Peak host memory, and peak GPU memory on CUDA runs."""
+    text = f"peak={r.get('peak_gb', float('nan')):.2f}GB"
+    if "gpu_peak_gb" in r:
+        text += f" gpu={r['gpu_peak_gb']:.2f}GB"
+    return text
+
+
 def _row(*cols):
     print(" | ".join(str(c) for c in cols), flush=True)
 
@@ -122,49 +133,57 @@ def main(argv=None):
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--vns", nargs="*", default=["bulbasaur", "guitar", "phone_flowrep",
                                                   "trebol_flowrep", "torus"])
+    ap.add_argument("--device", default="cpu", help="cpu or cuda")
+    ap.add_argument("--reference-quality", default="default",
+                    help="preset of the rough-sphere comparison (default: default)")
+    ap.add_argument("--vns-quality", default="draft", help="preset of the vns section")
+    ap.add_argument("--png-dir", default="/tmp", help="where the vns previews go")
     ap.add_argument("--worker", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     if a.worker:
         print(json.dumps(_worker(json.loads(a.worker))))
         return
-    print(f"# load average at start: {os.getloadavg()} (2 shared cores)")
+    print(f"# load average at start: {os.getloadavg()}; device {a.device}")
+    base = {"threads": a.threads, "device": a.device}
+    png = Path(a.png_dir)
     vns = DATA / "sketches" / "vns"
     if "draft100" in a.only:
         path = vns / "input" / "gamepad.obj"
-        r = _run({"kind": "sketch", "path": str(path), "quality": "draft",
-                  "threads": a.threads, "png": "/tmp/neural_gamepad.png"})
+        r = _run({**base, "kind": "sketch", "path": str(path), "quality": "draft",
+                  "png": str(png / "neural_gamepad.png")})
         _row("draft100", path.name, f"strokes={r.get('strokes')}",
-             f"time={r.get('time_s', float('nan')):.1f}s (target < 90 s)",
-             f"peak={r.get('peak_gb', float('nan')):.2f}GB", r.get("error", ""))
+             f"time={r.get('time_s', float('nan')):.1f}s (target < 90 s)", _memory(r),
+             r.get("error", ""))
     if "steps" in a.only:
         for quality in ("default", "paper"):
             for res in (128, 256):
-                n = 2
-                r = _run({"kind": "sketch", "path": str(vns / "input" / "gamepad.obj"),
-                          "quality": quality, "threads": a.threads,
+                n = 2 if a.device == "cpu" else 20
+                r = _run({**base, "kind": "sketch", "path": str(vns / "input" / "gamepad.obj"),
+                          "quality": quality,
                           "overrides": {"res": res, "init_steps": 1, "steps": n}})
                 per = r["timings"]["full"] / n if "timings" in r else float("nan")
-                _row("steps", quality, f"{res}^3", f"{per:.2f} s/step (full stage)",
-                     f"peak={r.get('peak_gb', float('nan')):.2f}GB", r.get("error", ""))
+                _row("steps", quality, f"{res}^3", f"{per:.3f} s/step (full stage, {n} steps)",
+                     _memory(r), r.get("error", ""))
     if "reference" in a.only:
-        r = _run({"kind": "sphere", "quality": "default", "threads": a.threads})
+        r = _run({**base, "kind": "sphere", "quality": a.reference_quality})
         _row("reference", "method", "time", "peak memory", "F-score@0.01", "Chamfer")
         _row("reference", "published code, 128^3 x 300 steps", f"{REFERENCE['time_s']:.0f}s",
              f"{REFERENCE['peak_gb']:.1f}GB", f"{REFERENCE['fscore']:.3f}",
              f"{REFERENCE['chamfer']:.2e}")
+        label = f"ours {a.reference_quality} on {a.device}"
         if "error" in r:
-            _row("reference", "ours default", r["error"])
+            _row("reference", label, r["error"])
         else:
-            _row("reference", f"ours default ({r['strokes']} strokes)", f"{r['time_s']:.0f}s",
-                 f"{r['peak_gb']:.2f}GB", f"{r['fscore']:.3f}", f"{r['chamfer']:.2e}")
+            _row("reference", f"{label} ({r['strokes']} strokes)", f"{r['time_s']:.1f}s",
+                 _memory(r), f"{r['fscore']:.3f}", f"{r['chamfer']:.2e}")
     if "vns" in a.only:
         for name in a.vns:
             path = vns / f"{name}.obj"
-            r = _run({"kind": "sketch", "path": str(path), "quality": "draft",
-                      "threads": a.threads, "png": f"/tmp/neural_{name}.png"})
-            _row("vns", name, f"strokes={r.get('strokes')}",
+            r = _run({**base, "kind": "sketch", "path": str(path), "quality": a.vns_quality,
+                      "png": str(png / f"neural_{Path(name).name}.png")})
+            _row("vns", a.vns_quality, name, f"strokes={r.get('strokes')}",
                  f"time={r.get('time_s', float('nan')):.1f}s", f"faces={r.get('faces')}",
-                 r.get("png", ""), r.get("error", ""))
+                 _memory(r), r.get("error", ""))
     print(f"# load average at end: {os.getloadavg()}")
 
 
