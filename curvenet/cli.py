@@ -29,6 +29,14 @@ def _fraction(text: str) -> float:
     return value
 
 
+def _neural_setting(text: str) -> tuple[str, object]:
+    from neural.presets import parse_setting
+    try:
+        return parse_setting(text)
+    except ValueError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
+
+
 def _positive_int(text: str) -> int:
     try:
         value = int(text)
@@ -83,6 +91,10 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--closed-box", action="store_true",
                    help="neural: f = outside on the box walls, so the surface closes "
                         "inside the box (default: the paper's periodic box)")
+    s.add_argument("--neural-set", type=_neural_setting, action="append", default=[],
+                   metavar="NAME=VALUE",
+                   help="override one neural setting (neural.presets.FlowConfig), repeatable: "
+                        "--neural-set res=96 --neural-set w_smooth=0.01")
     s.add_argument("--seed", type=int, default=0)
     s.add_argument("--preview", metavar="PNG", help="write a picture of the result")
     s.add_argument("--up", choices=("x", "y", "z"), default="z", help="up axis of the preview")
@@ -133,6 +145,14 @@ def _cmd_patches(args) -> int:
     return 0
 
 
+def _neural_options(args) -> dict | None:
+    """``--neural-set`` overrides, with ``--closed-box`` as ``boundary="dirichlet"``."""
+    options = dict(args.neural_set)
+    if args.closed_box:
+        options["boundary"] = "dirichlet"
+    return options or None
+
+
 def _surface_one(inp: str, out: str, args) -> dict:
     """Surface one input; returns a status row (never raises CurvenetError)."""
     from .patchset import load_network_file
@@ -145,7 +165,7 @@ def _surface_one(inp: str, out: str, args) -> dict:
                       resolution=args.resolution, crease_angle=args.crease_angle,
                       refine=args.refine, quality=args.quality, device=args.device,
                       seed=args.seed, progress=not args.no_progress,
-                      neural_options={"boundary": "dirichlet"} if args.closed_box else None)
+                      neural_options=_neural_options(args))
         res.save(out)
         if args.preview:
             from .preview import render_preview

@@ -10,17 +10,29 @@ SIREN with omega_0 = 30, 10k / 15k / 15k Monte-Carlo samples on strokes,
 surface and volume, 200 initialisation + 800 full Adam steps, a 256^3 grid on
 the bounding box padded by 20 %, loss weights 1, 0.01, 30, 7, 7 and Eikonal
 sigma = 0.5. The learning rate and gradient clipping are not given in the
-paper; we take the published code's values (Adam lr 5e-5, clip 10).
+paper; we take the published code's values (Adam lr 5e-5, clip 10). It is
+meant for a GPU: 44-58 s per sketch on one H100 (0.05-0.06 s per full step at
+128^3 and 256^3 alike, 5.5 GB of GPU memory).
 
 ``draft`` is sized for a 2-core CPU in about a minute; ``default`` balances
-quality and time (a tenth of the reference's time on a CPU). Both raise the
-smoothness weight from the paper's 0.01 to 0.1: with their short budgets the
-paper's weight leaves mid-frequency bumps. Measured on rough re-drawn shapes
-at draft (seed 0, F-score at 0.01): sphere 0.923 -> 0.994, ellipsoid 0.950 ->
-0.978, torus 0.734 -> 0.953, capped cylinder 0.568 -> 0.635. ``paper`` keeps
-0.01. Both solve the
-Poisson equation every ``poisson_every`` steps and use the linearised data term
-in between (see :mod:`neural.flow`).
+quality and time (a tenth of the reference's time on a CPU; 12-13 s per vns
+sketch on an H100). Both raise the smoothness weight from the paper's 0.01 to
+0.1: with their short budgets the paper's weight leaves mid-frequency bumps.
+Measured on rough re-drawn shapes at draft (seed 0, F-score at 0.01): sphere
+0.923 -> 0.994, ellipsoid 0.950 -> 0.978, torus 0.734 -> 0.953, capped
+cylinder 0.568 -> 0.635.
+
+On a GPU, ``default`` is the better choice in this implementation. Rough
+shapes on an H100 (seed 0, F-score at 0.01): ``default`` sphere 0.999 in 7.7 s;
+``paper`` sphere 0.701 (faceted between the strokes), ellipsoid 0.987, torus
+0.960 (a small hole at the box wall). No change of ``paper`` was better on all
+three: sphere / ellipsoid / torus with the smoothness weight 0.1 and the
+published code's sphere initialisation 0.999 / 1.000 / 0.580 (torus genus
+lost); 0.1 alone 1.000 / 0.998 / 0.783; the sphere initialisation alone 0.719
+(sphere), 0.578 (torus); lr 2e-4 0.373, a 128^3 grid 0.739, a Gaussian
+low-pass of one cell 0.676 (torus). ``paper`` therefore keeps the published
+constants. Both solve the Poisson equation every ``poisson_every`` steps and
+use the linearised data term in between (see :mod:`neural.flow`).
 
 References
 ----------
@@ -32,7 +44,7 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, fields, replace
 
-__all__ = ["FlowConfig", "PRESETS", "get_config"]
+__all__ = ["FlowConfig", "PRESETS", "get_config", "parse_setting"]
 
 
 @dataclass(frozen=True)
@@ -211,3 +223,39 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
         if getattr(cfg, name) not in allowed:
             raise ValueError(f"{name} must be one of {allowed}, got {getattr(cfg, name)!r}")
     return cfg
+
+
+def parse_setting(text: str) -> tuple[str, object]:
+    """``"name=value"`` (a command-line override) -> ``(name, value)`` typed as the field.
+
+    Ranges are checked later by :func:`get_config`.
+
+    Raises
+    ------
+    ValueError
+        No ``=``, an unknown field, or a value that does not parse as the field's type.
+
+    Examples
+    --------
+    >>> parse_setting("w_smooth=0.01")
+    ('w_smooth', 0.01)
+    >>> parse_setting("splat_volume=yes")
+    ('splat_volume', True)
+    """
+    name, sep, raw = text.partition("=")
+    name, raw = name.strip(), raw.strip()
+    kinds = {f.name: type(f.default) for f in fields(FlowConfig)}
+    if not sep or not name:
+        raise ValueError(f"expected NAME=VALUE, got {text!r}")
+    if name not in kinds:
+        raise ValueError(f"unknown neural setting {name!r}; valid: {sorted(kinds)}")
+    kind = kinds[name]
+    if kind is bool:
+        truth = {"true": True, "yes": True, "1": True, "false": False, "no": False, "0": False}
+        if raw.lower() not in truth:
+            raise ValueError(f"{name} takes true or false, got {raw!r}")
+        return name, truth[raw.lower()]
+    try:
+        return name, kind(raw)
+    except ValueError:
+        raise ValueError(f"{name} takes a {kind.__name__}, got {raw!r}") from None

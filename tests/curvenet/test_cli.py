@@ -118,9 +118,13 @@ def test_outputs_get_ordinary_permissions(tmp_path, box_obj):
     assert stat.S_IMODE(out.stat().st_mode) == 0o666 & ~mask
 
 
-@pytest.mark.parametrize("flag,expected", [((), None),
-                                           (("--closed-box",), {"boundary": "dirichlet"})])
-def test_closed_box_flag_reaches_the_neural_fit(tmp_path, box_obj, monkeypatch, flag, expected):
+@pytest.mark.parametrize("flag,expected", [
+    ((), None),
+    (("--closed-box",), {"boundary": "dirichlet"}),
+    (("--neural-set", "w_smooth=0.01", "--neural-set", "res=40", "--closed-box"),
+     {"w_smooth": 0.01, "res": 40, "boundary": "dirichlet"}),
+])
+def test_neural_flags_reach_the_neural_fit(tmp_path, box_obj, monkeypatch, flag, expected):
     import curvenet.pipeline as pipeline
     seen = {}
     real = pipeline.surface
@@ -134,3 +138,19 @@ def test_closed_box_flag_reaches_the_neural_fit(tmp_path, box_obj, monkeypatch, 
                  "--no-progress", *flag]) == 0
     assert seen["method"] == "neural" and seen["neural_options"] == expected
     assert out.exists()
+
+
+@pytest.mark.parametrize("value,match", [("w_smooth", "NAME=VALUE"), ("bogus=1", "unknown"),
+                                         ("res=big", "int"), ("splat_volume=maybe", "true")])
+def test_bad_neural_setting_is_one_clear_error(tmp_path, box_obj, capsys, value, match):
+    with pytest.raises(SystemExit) as exc:
+        main(["surface", str(box_obj), "-o", str(tmp_path / "m.obj"), "--neural-set", value])
+    assert exc.value.code == 2
+    assert match in capsys.readouterr().err
+    assert not (tmp_path / "m.obj").exists()
+
+
+def test_out_of_range_neural_setting_names_it(tmp_path, box_obj, capsys):
+    rc = main(["surface", str(box_obj), "-o", str(tmp_path / "m.obj"), "--method", "neural",
+               "--no-progress", "--neural-set", "res=2"])
+    assert rc != 0 and "res" in capsys.readouterr().err
