@@ -12,7 +12,8 @@ steps      seconds per full-stage step of ``default`` and ``paper`` at 128^3 and
 reference  ``default`` on an 18-stroke rough sphere: time, peak memory, F-score, Chamfer,
            next to the published code's figures on this CPU (128^3, 300 steps: ~22 min,
            13.8 GB, F 99.8 %, Chamfer 2.6e-3)
-vns        ``draft`` time per sketch on several vns sketches, PNG previews under /tmp
+vns        time per sketch (``--vns-quality``, default draft) on several vns sketches,
+           PNG previews under ``--png-dir`` (default /tmp)
 
 Measured 2026-11-24 on the shared 2-core CPU (load average 3-7 from other engineers;
 alone, draft takes ~12-16 s per sketch, as phone_flowrep/trebol show):
@@ -21,6 +22,11 @@ phone_flowrep 16.3 s, trebol_flowrep 15.7 s; s/step full stage: default 10.0 (12
 29.6 (256^3); paper 62.6 (128^3), 42.9 (256^3) (2-step runs, first-step overhead
 and load included); reference sphere (18 strokes), default: 590 s, 1.01 GB,
 F 0.833, Chamfer 5.2e-3 vs published code 1320 s, 13.8 GB, F 0.998, 2.6e-3.
+
+On one H100 (``--device cuda``, 2026-11-24): 0.05-0.06 s per full step for default
+and paper at 128^3 and 256^3; paper 51-57 s per vns sketch, default 12-13 s; the
+rough sphere at paper 56 s (F 0.62-0.70), at default 7.7 s (F 0.999). See
+benchmarks/README.md.
 
 Each measurement runs in a fresh subprocess so that peak memory (ru_maxrss) is its own.
 The machine is shared: note the load average printed with the table.
