@@ -316,9 +316,10 @@ def fit_flow_surface(strokes, *, labels=None, quality: str = "draft", device="cp
         Seeds the network initialisation and every sample; CPU runs are
         bit-for-bit reproducible.
     init_mesh : (vertices (V, 3), faces (F, 3)), optional
-        A classical surface to refine: g is first fitted to ``sigma`` times the
-        gradient of its signed distance (``prefit_steps``), then the full
-        stage runs (no initialisation stage).
+        A classical surface to refine: g is first regressed on ``sigma`` times
+        the gradient of its signed distance (``prefit_steps``; no curl term: the
+        target is a gradient, and a curl penalty on the random SIREN collapsed g
+        to a constant), then the full stage runs (no initialisation stage).
     progress : bool
         Show a tqdm bar with the loss terms.
     cut_boundary : bool
@@ -450,8 +451,7 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
                 if stage == "prefit":
                     idx = torch.randint(len(P), (cfg.n_volume,), generator=gen, device=dev)
                     x = P[idx]
-                    g, G = net.jet(x, order=1)
-                    loss = ((g - target[idx]) ** 2).sum(-1).mean() + cfg.w_curl * curl_loss(G)
+                    loss = ((net(x) - target[idx]) ** 2).sum(-1).mean()
                     vals["total"] = loss
                 else:
                     full = stage == "full"

@@ -82,6 +82,19 @@ def test_refine_from_init_mesh():
     assert r.report["steps"] == {"prefit": 5, "full": 4}
 
 
+def test_refine_prefit_reproduces_the_init_mesh():
+    # the prefit regresses g on sigma * grad SDF of the mesh (|target|^2 = 0.25); it must fit
+    # it, and the bootstrapped surface (no full step) must be the mesh's sphere. A curl
+    # penalty in the prefit once collapsed g to a constant (MSE stuck at 0.25, F ~0.3)
+    import trimesh
+    m = trimesh.creation.icosphere(3, radius=1.0)
+    r = fit_flow_surface(_circles(), progress=False, init_mesh=(m.vertices, m.faces),
+                         quality="draft", res=48, prefit_steps=150, steps=0)
+    assert r.history["prefit"]["total"][-1] < 0.05
+    f, _ = fscore(r.vertices, r.faces, m.vertices, m.faces, threshold=0.02)
+    assert f >= 0.9, f
+
+
 def test_dirichlet_boundary_keeps_walls_outside():
     r = fit_flow_surface(_circles(), progress=False, boundary="dirichlet", **TINY)
     f = r.f_grid
