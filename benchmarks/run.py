@@ -5,6 +5,7 @@ Usage::
     python benchmarks/run.py                          # analytic shapes, all methods
     python benchmarks/run.py --set networks --methods auto,classical
     python benchmarks/run.py --set vns --methods auto --limit 5
+    python benchmarks/run.py --rough --methods classical,refine     # classical, then the flow fit
     python benchmarks/run.py --set all --markdown > table.md
 
 Columns: seconds, Chamfer, Hausdorff, F-score at 0.01 and normal error (degrees)
@@ -41,6 +42,7 @@ METHODS = {
     "soapfilm": dict(method="classical", surfacer="soapfilm"),
     "neural": dict(method="neural"),
     "auto": dict(method="auto"),
+    "refine": dict(method="classical", refine=True),
     "poisson": None,  # point-cloud baseline, see poisson_baseline()
 }
 
