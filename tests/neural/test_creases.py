@@ -29,6 +29,16 @@ def _box_mesh():
     return np.asarray(m.vertices), np.asarray(m.faces)
 
 
+BOX_CORNERS = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], float)
+
+
+def _box_edges():
+    """The 12 edges of the unit box as straight 20-point strokes."""
+    c = BOX_CORNERS
+    edges = [(a, b) for a in range(8) for b in range(a + 1, 8) if bin(a ^ b).count("1") == 1]
+    return [c[a] + np.linspace(0, 1, 20)[:, None] * (c[b] - c[a]) for a, b in edges]
+
+
 def test_guides_on_a_box_edge_are_the_bisector():
     v, f = _box_mesh()
     # edge from (1, 1, 0) to (1, 1, 1): sides x = 1 (normal +x) and y = 1 (normal +y)
@@ -75,14 +85,12 @@ def test_strip_geometry():
 
 def test_box_feature_set_channels_and_crease():
     v, f = _box_mesh()
-    c = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], float)
-    edges = [(a, b) for a in range(8) for b in range(a + 1, 8) if bin(a ^ b).count("1") == 1]
-    strokes = [c[a] + np.linspace(0, 1, 20)[:, None] * (c[b] - c[a]) for a, b in edges]
+    strokes = _box_edges()
     mv, mt, mc = crease_feature_set(strokes, v, f, width=0.05, spacing=0.1, guide_radius=0.2)
     assert mc.max() + 1 == 3 or mc.max() + 1 == 4  # cube graph: >= 3 channels at corners
     # strokes meeting at a corner carry different channels
     tri_c = mv[mt].mean(1)
-    for corner in c:
+    for corner in BOX_CORNERS:
         near = np.linalg.norm(tri_c - corner, axis=1) < 0.06
         assert len(set(mc[near])) >= 3
     # the feature function is C0 with a derivative jump across the strip (which contains the
@@ -120,9 +128,7 @@ def test_segment_strip_2d_gives_corner_crease():
 
 def test_crease_refine_smoke_and_determinism():
     v, f = _box_mesh()
-    c = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], float)
-    edges = [(a, b) for a in range(8) for b in range(a + 1, 8) if bin(a ^ b).count("1") == 1]
-    strokes = [c[a] + np.linspace(0, 1, 20)[:, None] * (c[b] - c[a]) for a, b in edges]
+    strokes = _box_edges()
     kw = dict(steps=15, res=24, pool=3000, batch=500, hidden=16, layers=2, progress=False)
     r1 = crease_refine(v, f, strokes, ["crease"] * 12, **kw)
     r2 = crease_refine(v, f, strokes, ["crease"] * 12, **kw)

@@ -82,11 +82,9 @@ def test_rough_torus_default_on_cuda_has_genus_one():
 def test_crease_refine_on_cuda():
     from neural.creases import crease_refine
 
-    from .test_creases import _box_mesh
+    from .test_creases import _box_edges, _box_mesh
     v, f = _box_mesh()
-    c = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], float)
-    edges = [(a, b) for a in range(8) for b in range(a + 1, 8) if bin(a ^ b).count("1") == 1]
-    strokes = [c[a] + np.linspace(0, 1, 20)[:, None] * (c[b] - c[a]) for a, b in edges]
+    strokes = _box_edges()
     r = crease_refine(v, f, strokes, ["crease"] * 12, steps=30, res=32, progress=False,
                       device="cuda")
     assert r.report["n_channels"] >= 3 and np.isfinite(r.report["final_loss"])
