@@ -26,10 +26,11 @@ point-to-plane targets is already sharp, both errors are dominated by face wavin
 median dihedral angle 89.2 / 88.3 deg, worst stroke within 3.2 / 2.7 deg of 90.
 Box on the real draft flow fit (``--input flow --threads 2``, idle machine, 161 s in all):
 input 27.78 deg, without the strips 24.57, with them 24.45 (ratio 1.00); the flow fit's
-faces bulge like pillows (a sphere cap and a plane are both free in its energy), which the
-crease refit keeps; its worst stroke is 81 deg from a right angle. With the closed box
-(``--boundary dirichlet``): input 20.09 deg, without the strips 13.85, with them 13.67
-(ratio 1.01 against the refit, 1.47 against the flow fit); median dihedral 142 deg.
+faces bulge like pillows (its smoothness term prefers faces that meet tangent-continuously,
+see ``bench_flow_limits.py``), which the crease refit keeps; its worst stroke is 81 deg
+from a right angle. With the closed box (``--boundary dirichlet``): input 20.09 deg, without
+the strips 13.85, with them 13.67 (ratio 1.01 against the refit, 1.47 against the flow fit);
+median dihedral 142 deg.
 """
 
 from __future__ import annotations

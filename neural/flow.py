@@ -47,6 +47,10 @@ Engineering choices (documented deviations / gap fills)
 * Known limitation: a zero set may leave through the periodic box where no
   stroke holds it (a capped cylinder whose caps carry no strokes becomes an
   open tube: the smoothness term prefers it); such surfaces are not watertight.
+  The smoothness term charges a rounded crease like 1 / (rounding width), so
+  where strokes bound a region without strokes it prefers tangent-continuous
+  surfaces: its minimiser for that cylinder is a capsule (F 0.58 against the
+  flat caps), and box faces bulge into pillows (``benchmarks/bench_flow_limits.py``).
   ``boundary="dirichlet"`` closes them inside the box, but not at the rims (see
   :class:`neural.presets.FlowConfig`). A minimal-area term (first variation of
   the zero set's area through f) and a wall penalty were tried and did not
