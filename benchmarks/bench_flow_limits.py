@@ -194,15 +194,14 @@ class _Oracle:
         import trimesh
 
         from neural.extract import marching_cubes_world
-        from neural.poisson import interpolate, normalize_scale_shift, splat
+        from neural.poisson import interpolate, normalize_scale_shift, normalize_splat, splat
 
         surf = self.frame.to_unit(trimesh.sample.sample_surface(self.ref, n_surface, seed=1)[0])
         pts = torch.tensor(np.vstack([self.xs, surf]))
         g = torch.tensor(_reference_gradient(self.ref, self.frame.to_world(pts.numpy())))
         grid, wsum = splat(pts, g, self.res)
         if normalise:
-            wref = wsum.sum() / (wsum > 0).sum().clamp(min=1)
-            grid = grid / torch.maximum(wsum, wref)
+            grid = normalize_splat(grid, wsum)
         f = self.solver.solve(grid)
         at = pts[: self.n_stroke] if shift_on == "strokes" else pts
         f = normalize_scale_shift(f, interpolate(f, at))[0].numpy()
@@ -248,7 +247,6 @@ def bench_refit(args) -> None:
     V, F = oracle.surface(args.surface_samples[0], shift_on="strokes", normalise=True)
     V, F = keep_supported_components(V, F, sk.strokes, 4 * oracle.frame.side / oracle.res)
     clean = oracle.shape.sketch().strokes
-    voxel = 2.0 / 1.6 / 127          # one step of the refit's 128^3 grid, box side 1
     print(f"crease refit of the box reconstructed from its exact gradient ({args.res}^3, "
           f"{args.stroke_samples} + {args.surface_samples[0]} samples, normalised):")
     m = evaluate_mesh((V, F), oracle.ref, n_samples=30_000)
@@ -258,6 +256,7 @@ def bench_refit(args) -> None:
         r = crease_refine(V, F, list(sk.strokes), list(sk.labels), seed=0, progress=False,
                           use_features=use)
         m = evaluate_mesh((r.vertices, r.faces), oracle.ref, n_samples=30_000)
+        voxel = 2.0 / 1.6 / (r.report["config"]["res"] - 1)   # refit grid step, box side 1
         dih = dihedral_angles(r.vertices, r.faces, clean, r0=3.5 * voxel, r1=8.0 * voxel)
         print(f"{name:10s} normal error {m['normal_error_deg']:6.2f} deg, median dihedral "
               f"{np.median(dih):6.1f} deg ({time.perf_counter() - t0:.0f} s)", flush=True)
@@ -285,4 +284,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    main()

@@ -47,14 +47,14 @@ Engineering choices (documented deviations / gap fills)
 * Known limitation: a zero set may leave through the periodic box where no
   stroke holds it (a capped cylinder whose caps carry no strokes becomes an
   open tube: the smoothness term prefers it); such surfaces are not watertight.
-  The smoothness term charges a rounded crease like 1 / (rounding width), so
-  where strokes bound a region without strokes it prefers tangent-continuous
-  surfaces: its minimiser for that cylinder is a capsule (F 0.58 against the
-  flat caps), and box faces bulge into pillows (``benchmarks/bench_flow_limits.py``).
   ``boundary="dirichlet"`` closes them inside the box, but not at the rims (see
   :class:`neural.presets.FlowConfig`). A minimal-area term (first variation of
   the zero set's area through f) and a wall penalty were tried and did not
-  move the closure to the rims within the draft budget.
+  move the closure to the rims within the draft budget. The smoothness term
+  charges a rounded crease like 1 / (rounding width), so where strokes bound a
+  region without strokes it prefers tangent-continuous surfaces: its minimiser
+  for that cylinder is a capsule (F 0.58 against the flat caps), and box faces
+  bulge into pillows (``benchmarks/bench_flow_limits.py``).
 * Final mesh: pieces of the zero set with no stroke within 4 grid cells are
   dropped (spurious level-set components of the periodic f).
 
@@ -371,7 +371,8 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
     from .extract import cut_along_boundary, keep_supported_components, marching_cubes_world
     from .losses import (alignment_loss, curl_loss, data_loss, eikonal_loss, smoothness_loss,
                          smoothness_loss_autograd)
-    from .poisson import PoissonSolver, interpolate, normalize_scale_shift, splat
+    from .poisson import (PoissonSolver, interpolate, normalize_scale_shift, normalize_splat,
+                          splat)
     from .siren import GradientSiren
 
     t_start = time.perf_counter()
@@ -415,8 +416,7 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
         if need_adjoint:
             raw.retain_grad()
         if normalize:
-            wref = wsum.sum() / (wsum > 0).sum().clamp(min=1)
-            grid = grid / torch.maximum(wsum, wref)
+            grid = normalize_splat(grid, wsum)
         f = solver.solve(grid)
         x_eval = points[: n_str_eval]
         f_s = interpolate(f, x_eval)

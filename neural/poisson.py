@@ -25,7 +25,8 @@ import math
 
 import torch
 
-__all__ = ["PoissonSolver", "splat", "interpolate", "normalize_scale_shift", "trilinear_stencil"]
+__all__ = ["PoissonSolver", "splat", "normalize_splat", "interpolate", "normalize_scale_shift",
+           "trilinear_stencil"]
 
 
 def trilinear_stencil(points: torch.Tensor, res: int):
@@ -79,6 +80,24 @@ def splat(points: torch.Tensor, values: torch.Tensor, res: int):
     wsum = torch.zeros(res ** 3, dtype=values.dtype, device=values.device)
     wsum = wsum.index_add(0, flat, w.reshape(-1).to(values.dtype))
     return grid.t().reshape(C, res, res, res), wsum.reshape(res, res, res)
+
+
+def normalize_splat(grid: torch.Tensor, weight: torch.Tensor) -> torch.Tensor:
+    """Per-node normalisation of a splatted field ("once stabilised", Sec. 5.1).
+
+    Each node's sum is divided by ``max(weight, mean positive weight)``: the density bias of
+    the samples goes, and sparsely hit nodes are not inflated.
+
+    Parameters
+    ----------
+    grid : (C, res, res, res), weight : (res, res, res), as returned by :func:`splat`
+
+    Returns
+    -------
+    (C, res, res, res)
+    """
+    wref = weight.sum() / (weight > 0).sum().clamp(min=1)
+    return grid / torch.maximum(weight, wref)
 
 
 def interpolate(grid: torch.Tensor, points: torch.Tensor, *, with_gradient: bool = False):

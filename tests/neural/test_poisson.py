@@ -5,7 +5,8 @@ import math
 import pytest
 import torch
 
-from neural.poisson import PoissonSolver, interpolate, normalize_scale_shift, splat
+from neural.poisson import (PoissonSolver, interpolate, normalize_scale_shift, normalize_splat,
+                            splat)
 
 
 def _grid(n, dtype=torch.float64):
@@ -108,6 +109,21 @@ def test_interpolate_reproduces_linear_function_and_gradient():
     assert torch.allclose(v, exact, atol=1e-12)
     assert torch.allclose(gr, torch.tensor([0.3, -0.7, 0.2], dtype=torch.float64).expand(100, 3),
                           atol=1e-10)
+
+
+def test_normalize_splat_averages_dense_nodes_and_keeps_sparse_ones_small():
+    # 10 equal values at one node centre (weight 10) and one value at another (weight 1):
+    # mean positive weight 5.5, so the dense node becomes the average and the sparse one is
+    # divided by 5.5, not inflated to the full value
+    res = 8
+    dense, sparse = (torch.tensor([2, 3, 4]) + 0.5) / res, (torch.tensor([6, 6, 6]) + 0.5) / res
+    pts = torch.cat([dense.expand(10, 3), sparse[None]]).double()
+    vals = torch.full((11, 1), 3.0, dtype=torch.float64)
+    grid, w = splat(pts, vals, res)
+    out = normalize_splat(grid, w)
+    assert out[0, 2, 3, 4].item() == pytest.approx(3.0)
+    assert out[0, 6, 6, 6].item() == pytest.approx(3.0 / 5.5)
+    assert (out[0][w == 0] == 0).all()
 
 
 def test_scale_shift_normalisation():
