@@ -206,7 +206,8 @@ def _strokes_for_neural(sketch: Sketch | None, net: CurveNetwork | None):
     return [e.curve for e in net.edges], [e.label for e in net.edges]
 
 
-def _neural(strokes, labels, *, quality, device, seed, progress, init_mesh, options):
+def _neural(strokes, labels, *, quality, device, seed, progress, init_mesh, options,
+            crease_options):
     from neural.flow import fit_flow_surface
     res = fit_flow_surface(strokes, labels=labels, quality=quality, device=device, seed=seed,
                            init_mesh=init_mesh, progress=progress, **options)
@@ -214,7 +215,7 @@ def _neural(strokes, labels, *, quality, device, seed, progress, init_mesh, opti
     if "crease" in labels and not report.get("interrupted"):
         from neural.creases import crease_refine
         cres = crease_refine(verts, faces, strokes, labels, quality=quality, device=device,
-                             seed=seed, progress=progress)
+                             seed=seed, progress=progress, **crease_options)
         verts, faces = cres.vertices, cres.faces
         report["creases"] = dict(cres.report)
     return _mesh(verts, faces), report
@@ -226,7 +227,8 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
             crease_angle: float = 30.0, refine: bool = False, quality: str = "draft",
             device: str = "cpu", seed: int = 0, progress: bool = False,
             classical_options: dict | None = None,
-            neural_options: dict | None = None) -> SurfaceResult:
+            neural_options: dict | None = None,
+            crease_options: dict | None = None) -> SurfaceResult:
     """Sketch (or network, or patch set) to surface.
 
     Parameters
@@ -263,6 +265,10 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
     classical_options, neural_options : dict, optional
         Extra keyword arguments for :func:`surfacing.surface_loops` /
         :func:`neural.flow.fit_flow_surface`.
+    crease_options : dict, optional
+        Settings of the crease refit (:class:`neural.creases.CreaseConfig`, e.g.
+        ``{"use_features": False}``), used when the neural route meets strokes labelled
+        ``crease``; checked before any fit.
 
     Returns
     -------
@@ -285,6 +291,12 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
         raise InvalidParameterError(f"crease_angle: {crease_angle!r} is not in (0, 180)")
     if device not in ("cpu", "cuda") and not str(device).startswith("cuda:"):
         raise InvalidParameterError(f"device: {device!r} is not cpu or cuda")
+    if crease_options:
+        from neural.creases import crease_config
+        try:
+            crease_config(quality, crease_options)
+        except ValueError as err:
+            raise InvalidParameterError(f"crease_options: {err}") from err
     timings: dict = {}
     diag: dict = {}
     sketch, given = load_source(source)
@@ -341,7 +353,8 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
             init = (np.asarray(mesh.vertices), np.asarray(mesh.faces)) if mesh is not None else None
             t = time.perf_counter()
             mesh, rep = _neural(strokes, labels, quality=quality, device=device, seed=seed,
-                                progress=progress, init_mesh=init, options=neural_options or {})
+                                progress=progress, init_mesh=init, options=neural_options or {},
+                                crease_options=crease_options or {})
             timings["neural"] = time.perf_counter() - t
             diag["neural"] = rep
             name = name + "+refine" if init is not None else "neural"

@@ -37,6 +37,7 @@ from ._inputs import check_strokes
 
 __all__ = [
     "CreaseConfig",
+    "crease_config",
     "CreaseResult",
     "CREASE_PRESETS",
     "guide_directions",
@@ -418,7 +419,15 @@ CREASE_PRESETS = {
 }
 
 
-def _get_config(quality: str, overrides: dict) -> CreaseConfig:
+def crease_config(quality: str = "draft", overrides: dict | None = None) -> CreaseConfig:
+    """The preset ``quality`` with ``overrides`` (field name -> value) applied and checked.
+
+    Raises
+    ------
+    ValueError
+        Unknown preset or field, or a value out of range.
+    """
+    overrides = overrides or {}
     if quality not in CREASE_PRESETS:
         raise ValueError(f"quality must be one of {sorted(CREASE_PRESETS)}, got {quality!r}")
     names = {f.name for f in fields(CreaseConfig)}
@@ -550,7 +559,7 @@ def crease_refine(vertices, faces, strokes, labels=None, *, quality: str = "draf
     from .feature import mollified_feature_function
     from .sharpnet import FeatureSet, SharpNet, positional_encoding
 
-    cfg = _get_config(quality, overrides)
+    cfg = crease_config(quality, overrides)
     v, f, st, lab = _check_inputs(vertices, faces, strokes, labels)
     try:
         dev = torch.device(device)

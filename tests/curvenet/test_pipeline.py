@@ -73,3 +73,30 @@ def test_bad_parameters_raise_curvenet_errors():
         curvenet.surface(Sketch([[[0, 0, 0], [1, 0, 0]]]), method="classical")
     with pytest.raises(curvenet.SketchFormatError, match="no such file"):
         curvenet.surface("/nonexistent/sketch.obj")
+    # crease-refit settings are checked before any fit
+    with pytest.raises(curvenet.InvalidParameterError, match="bogus"):
+        curvenet.surface(sk, method="neural", crease_options={"bogus": 1})
+    with pytest.raises(curvenet.InvalidParameterError, match="steps"):
+        curvenet.surface(sk, method="neural", crease_options={"steps": 0})
+
+
+def test_crease_options_reach_the_crease_refit(monkeypatch):
+    import types
+
+    import neural.creases
+    import neural.flow
+    box = shapes.box()
+    ref = box.reference_mesh()
+    seen = {}
+
+    def flow(strokes, **kw):
+        return types.SimpleNamespace(vertices=np.asarray(ref.vertices),
+                                     faces=np.asarray(ref.faces), report={})
+
+    def refit(v, f, strokes, labels, **kw):
+        seen.update(kw)
+        return types.SimpleNamespace(vertices=v, faces=f, report={})
+    monkeypatch.setattr(neural.flow, "fit_flow_surface", flow)
+    monkeypatch.setattr(neural.creases, "crease_refine", refit)
+    res = curvenet.surface(box.sketch(), method="neural", crease_options={"use_features": False})
+    assert seen["use_features"] is False and res.diagnostics["neural"]["creases"] == {}
