@@ -236,7 +236,7 @@ def bench_splat(args) -> None:
 def bench_refit(args) -> None:
     import torch
 
-    from bench_sharpnet import dihedral_angles
+    from bench_sharpnet import box_dihedrals
     from curvenet.evaluate import evaluate_mesh
     from neural.creases import crease_refine
     from neural.extract import keep_supported_components
@@ -256,8 +256,7 @@ def bench_refit(args) -> None:
         r = crease_refine(V, F, list(sk.strokes), list(sk.labels), seed=0, progress=False,
                           use_features=use)
         m = evaluate_mesh((r.vertices, r.faces), oracle.ref, n_samples=30_000)
-        voxel = 2.0 / 1.6 / (r.report["config"]["res"] - 1)   # refit grid step, box side 1
-        dih = dihedral_angles(r.vertices, r.faces, clean, r0=3.5 * voxel, r1=8.0 * voxel)
+        dih = box_dihedrals(r.vertices, r.faces, clean, r.report["config"]["res"])
         print(f"{name:10s} normal error {m['normal_error_deg']:6.2f} deg, median dihedral "
               f"{np.median(dih):6.1f} deg ({time.perf_counter() - t0:.0f} s)", flush=True)
 

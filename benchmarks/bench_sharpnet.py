@@ -184,6 +184,13 @@ def dihedral_angles(vertices, faces, strokes, *, r0: float, r1: float, margin: f
     return np.array(out)
 
 
+def box_dihedrals(vertices, faces, strokes, res: int):
+    """:func:`dihedral_angles` across the unit box's edges, measured 3.5 to 8 steps of a
+    crease refit's ``res``-point grid away from them (the unit frame maps side 1 to 1.6)."""
+    voxel = 2.0 / 1.6 / (res - 1)
+    return dihedral_angles(vertices, faces, strokes, r0=3.5 * voxel, r1=8.0 * voxel)
+
+
 def _preview(meshes: dict, path: Path) -> None:
     import matplotlib
 
@@ -250,7 +257,6 @@ def bench_box(args) -> None:
                           use_features=use, **over)
         secs[name] = time.perf_counter() - t1
         results[name] = (r.vertices, r.faces)
-    voxel = 2.0 * 1.0 / 1.6 / (args.res - 1)  # world size of one grid step (box side 1)
     clean = shape.sketch().strokes
     print(f"box sketch ({'clean' if args.clean else 'rough'}, 12 crease strokes), input: "
           f"{args.input}; {args.activation}, {args.steps} steps, grid {args.res}^3, "
@@ -260,7 +266,7 @@ def bench_box(args) -> None:
     rows = {}
     for name, (v, f) in results.items():
         m = evaluate_mesh((v, f), ref, n_samples=30000, seed=0)
-        dih = dihedral_angles(v, f, clean, r0=3.5 * voxel, r1=8.0 * voxel)
+        dih = box_dihedrals(v, f, clean, args.res)
         dev = np.abs(dih - 90.0)
         rows[name] = (m["normal_error_deg"], m["chamfer"], dih)
         print(f"{name:18s} {m['normal_error_deg']:10.2f} {m['chamfer']:9.2e} "
