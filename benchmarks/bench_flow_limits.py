@@ -117,7 +117,7 @@ def cap_energy(k: float, tau: float, *, n: int = 600_000, eps: float = 0.004, se
     import torch
     from torch.func import jacfwd, vmap
 
-    from neural.geometry import covariant_tv
+    from curvenet.neural.geometry import covariant_tv
 
     F = _capped_solid(k, tau)
     g_f = jacfwd(F)
@@ -175,8 +175,8 @@ class _Oracle:
 
         from curvenet.redraw import rough_sketch
         from curvenet.shapes import SHAPES
-        from neural.flow import Frame, StrokeSampler
-        from neural.poisson import PoissonSolver
+        from curvenet.neural.flow import Frame, StrokeSampler
+        from curvenet.neural.poisson import PoissonSolver
 
         self.shape = SHAPES[name]()
         self.ref = self.shape.reference_mesh(4)
@@ -193,8 +193,8 @@ class _Oracle:
         import torch
         import trimesh
 
-        from neural.extract import marching_cubes_world
-        from neural.poisson import interpolate, normalize_scale_shift, normalize_splat, splat
+        from curvenet.neural.extract import marching_cubes_world
+        from curvenet.neural.poisson import interpolate, normalize_scale_shift, normalize_splat, splat
 
         surf = self.frame.to_unit(trimesh.sample.sample_surface(self.ref, n_surface, seed=1)[0])
         pts = torch.tensor(np.vstack([self.xs, surf]))
@@ -238,8 +238,8 @@ def bench_refit(args) -> None:
 
     from bench_sharpnet import box_dihedrals
     from curvenet.evaluate import evaluate_mesh
-    from neural.creases import crease_refine
-    from neural.extract import keep_supported_components
+    from curvenet.neural.creases import crease_refine
+    from curvenet.neural.extract import keep_supported_components
 
     torch.set_num_threads(args.threads)
     oracle = _Oracle("box", args.res, args.stroke_samples)

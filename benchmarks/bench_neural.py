@@ -54,7 +54,7 @@ def _worker(spec: dict) -> dict:
     import torch
     torch.set_num_threads(spec.get("threads", 2))
     sys.path.insert(0, str(ROOT))
-    from neural.flow import fit_flow_surface
+    from curvenet.neural.flow import fit_flow_surface
     out = {}
     if spec["kind"] == "sketch":
         from curvenet.io import read_sketch

@@ -54,7 +54,7 @@ RESULTS = Path(__file__).parent / "results"
 
 # ------------------------------------------------------------------------------ feature cost
 def _box_strips(n_tri: int = 2000, width: float = 0.05):
-    from neural.creases import strip_from_polyline
+    from curvenet.neural.creases import strip_from_polyline
 
     corners = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], float)
     edges = [(a, b) for a in range(8) for b in range(a + 1, 8)
@@ -75,7 +75,7 @@ def _box_strips(n_tri: int = 2000, width: float = 0.05):
 def _feature_worker(mode: str, n: int, grad: bool, radius: float) -> None:
     import torch
 
-    from neural.feature import feature_function, mollified_feature_function
+    from curvenet.neural.feature import feature_function, mollified_feature_function
 
     torch.set_num_threads(1)
     v, t = _box_strips()
@@ -228,7 +228,7 @@ def bench_box(args) -> None:
     from curvenet.evaluate import evaluate_mesh
     from curvenet.redraw import rough_sketch
     from curvenet.shapes import box
-    from neural.creases import crease_refine
+    from curvenet.neural.creases import crease_refine
 
     torch.set_num_threads(args.threads)
     shape = box()
@@ -241,7 +241,7 @@ def bench_box(args) -> None:
     elif args.input == "true":
         v_in, f_in = np.asarray(ref.vertices), np.asarray(ref.faces)
     else:
-        from neural.flow import fit_flow_surface
+        from curvenet.neural.flow import fit_flow_surface
         fr = fit_flow_surface(strokes, labels=labels, quality="draft", progress=False,
                               seed=args.seed, boundary=args.boundary)
         v_in, f_in = fr.vertices, fr.faces

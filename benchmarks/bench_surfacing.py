@@ -23,7 +23,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-import surfacing  # noqa: E402
+from curvenet import surfacing  # noqa: E402
 from curvenet import shapes  # noqa: E402
 from tests.surfacing._metrics import compare  # noqa: E402
 

@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 import torch
 
-from neural.sharpnet import FeatureSet, SharpNet
+from curvenet.neural.sharpnet import FeatureSet, SharpNet
 
 CENTRE = (1.0, 0.0)
 RADIUS = 0.5

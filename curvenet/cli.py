@@ -30,7 +30,7 @@ def _fraction(text: str) -> float:
 
 
 def _neural_setting(text: str) -> tuple[str, object]:
-    from neural.presets import parse_setting
+    from curvenet.neural.presets import parse_setting
     try:
         return parse_setting(text)
     except ValueError as err:

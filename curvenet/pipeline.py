@@ -179,7 +179,7 @@ def _mesh(vertices, faces):
 
 
 def _classical(ps: PatchSet, *, surfacer, subdiv, resolution, crease_angle, options):
-    import surfacing
+    from curvenet import surfacing
 
     from .cycles import orient_patches
     net = ps.network
@@ -208,12 +208,12 @@ def _strokes_for_neural(sketch: Sketch | None, net: CurveNetwork | None):
 
 def _neural(strokes, labels, *, quality, device, seed, progress, init_mesh, options,
             crease_options):
-    from neural.flow import fit_flow_surface
+    from curvenet.neural.flow import fit_flow_surface
     res = fit_flow_surface(strokes, labels=labels, quality=quality, device=device, seed=seed,
                            init_mesh=init_mesh, progress=progress, **options)
     verts, faces, report = res.vertices, res.faces, dict(res.report)
     if "crease" in labels and not report.get("interrupted"):
-        from neural.creases import crease_refine
+        from curvenet.neural.creases import crease_refine
         cres = crease_refine(verts, faces, strokes, labels, quality=quality, device=device,
                              seed=seed, progress=progress, **crease_options)
         verts, faces = cres.vertices, cres.faces
@@ -292,7 +292,7 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
     if device not in ("cpu", "cuda") and not str(device).startswith("cuda:"):
         raise InvalidParameterError(f"device: {device!r} is not cpu or cuda")
     if crease_options:
-        from neural.creases import crease_config
+        from curvenet.neural.creases import crease_config
         try:
             crease_config(quality, crease_options)
         except ValueError as err:

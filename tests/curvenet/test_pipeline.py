@@ -83,8 +83,8 @@ def test_bad_parameters_raise_curvenet_errors():
 def test_crease_options_reach_the_crease_refit(monkeypatch):
     import types
 
-    import neural.creases
-    import neural.flow
+    from curvenet.neural import creases as neural_creases
+    from curvenet.neural import flow as neural_flow
     box = shapes.box()
     ref = box.reference_mesh()
     seen = {}
@@ -96,7 +96,7 @@ def test_crease_options_reach_the_crease_refit(monkeypatch):
     def refit(v, f, strokes, labels, **kw):
         seen.update(kw)
         return types.SimpleNamespace(vertices=v, faces=f, report={})
-    monkeypatch.setattr(neural.flow, "fit_flow_surface", flow)
-    monkeypatch.setattr(neural.creases, "crease_refine", refit)
+    monkeypatch.setattr(neural_flow, "fit_flow_surface", flow)
+    monkeypatch.setattr(neural_creases, "crease_refine", refit)
     res = curvenet.surface(box.sketch(), method="neural", crease_options={"use_features": False})
     assert seen["use_features"] is False and res.diagnostics["neural"]["creases"] == {}

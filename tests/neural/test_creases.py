@@ -7,7 +7,7 @@ import pytest
 import torch
 import trimesh
 
-from neural.creases import (
+from curvenet.neural.creases import (
     crease_feature_set,
     crease_refine,
     guide_directions,
@@ -15,8 +15,8 @@ from neural.creases import (
     stroke_guides_from_mesh,
     strip_from_polyline,
 )
-from neural.feature import feature_function
-from neural.sharpnet import boundary_triples
+from curvenet.neural.feature import feature_function
+from curvenet.neural.sharpnet import boundary_triples
 
 D = torch.float64
 

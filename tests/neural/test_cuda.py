@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 import torch
 
-from neural.feature import feature_function, mollified_feature_function
-from neural.poisson import PoissonSolver, interpolate, splat
-from neural.siren import GradientSiren
+from curvenet.neural.feature import feature_function, mollified_feature_function
+from curvenet.neural.poisson import PoissonSolver, interpolate, splat
+from curvenet.neural.siren import GradientSiren
 
 from .test_flow import _fit_and_score
 
@@ -80,7 +80,7 @@ def test_rough_torus_default_on_cuda_has_genus_one():
 
 
 def test_crease_refine_on_cuda():
-    from neural.creases import crease_refine
+    from curvenet.neural.creases import crease_refine
 
     from .test_creases import _box_edges, _box_mesh
     v, f = _box_mesh()

@@ -3,7 +3,7 @@
 import numpy as np
 import trimesh
 
-from neural.extract import (cut_along_boundary, face_components, keep_supported_components,
+from curvenet.neural.extract import (cut_along_boundary, face_components, keep_supported_components,
                             marching_cubes_world, resample_polyline)
 
 

@@ -9,7 +9,7 @@ import pytest
 import torch
 from scipy import integrate
 
-from neural.feature import (
+from curvenet.neural.feature import (
     feature_function,
     mollified_feature_function,
     mollifier,
@@ -121,7 +121,7 @@ def test_harmonic_and_smooth_off_M():
     faces = torch.tensor([[0, 1, 2], [1, 3, 2], [3, 4, 5]])
     x = torch.tensor(rng.normal(size=(40, 3)) * 2.0, dtype=D)
     fun = lambda q: feature_function(q, verts, faces)  # noqa: E731
-    from neural.feature import element_centres
+    from curvenet.neural.feature import element_centres
     dist = torch.cdist(x, element_centres(verts, faces)).min(1).values
     keep = dist > 0.3
     lap = _fd_laplacian(fun, x[keep])
@@ -211,7 +211,7 @@ def test_mollified_jump_and_smoothness():
     p = torch.tensor([0.52, -0.03, 0.0], dtype=D)
     n = torch.tensor([0.0, 0.0, 1.0], dtype=D)
     up, dn = _one_sided_normal_derivatives(fun, p, n)
-    from neural.feature import element_centres
+    from curvenet.neural.feature import element_centres
     cen = element_centres(verts, faces)
     inside = [k for k, f in enumerate(faces.tolist())
               if _in_triangle(p[:2].numpy(), verts[f, :2].numpy())]

@@ -8,8 +8,8 @@ marked ``slow`` (the CI keeps the tiny end-to-end runs).
 import numpy as np
 import pytest
 
-from neural import flow
-from neural.flow import fit_flow_surface
+from curvenet.neural import flow
+from curvenet.neural.flow import fit_flow_surface
 
 from ._metrics import fscore
 

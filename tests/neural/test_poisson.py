@@ -5,7 +5,7 @@ import math
 import pytest
 import torch
 
-from neural.poisson import (PoissonSolver, interpolate, normalize_scale_shift, normalize_splat,
+from curvenet.neural.poisson import (PoissonSolver, interpolate, normalize_scale_shift, normalize_splat,
                             splat)
 
 

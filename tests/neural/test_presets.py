@@ -2,7 +2,7 @@
 
 import pytest
 
-from neural.presets import PRESETS, get_config
+from curvenet.neural.presets import PRESETS, get_config
 
 
 def test_paper_preset_matches_published_settings():

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 import torch
 
-from neural.feature import feature_function, mollified_feature_function
-from neural.sharpnet import (
+from curvenet.neural.feature import feature_function, mollified_feature_function
+from curvenet.neural.sharpnet import (
     FeatureSet,
     SharpNet,
     boundary_triples,

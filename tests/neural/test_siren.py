@@ -3,7 +3,7 @@
 import pytest
 import torch
 
-from neural.siren import GradientSiren
+from curvenet.neural.siren import GradientSiren
 
 
 def _autograd_derivatives(net, x):

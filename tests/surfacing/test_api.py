@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 import trimesh
 
-import surfacing
+from curvenet import surfacing
 from curvenet import shapes
 
 from ._metrics import compare

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from surfacing.catmull_clark import (edge_index, edge_topology, euler_characteristic, subdivide,
+from curvenet.surfacing.catmull_clark import (edge_index, edge_topology, euler_characteristic, subdivide,
                                      subdivision_step)
 
 from ._meshes import cube, grid

@@ -3,8 +3,8 @@ import pytest
 import trimesh
 
 from curvenet import shapes
-from surfacing.catmull_clark import edge_topology, euler_characteristic
-from surfacing.controlmesh import build_control_mesh, orient_loops
+from curvenet.surfacing.catmull_clark import edge_topology, euler_characteristic
+from curvenet.surfacing.controlmesh import build_control_mesh, orient_loops
 
 
 def _tri(cm):
@@ -120,7 +120,7 @@ def test_non_manifold_curve_is_shared_by_the_pieces():
 
 
 def test_adaptive_pieces_follow_quad_strips():
-    from surfacing.controlmesh import curve_pieces
+    from curvenet.surfacing.controlmesh import curve_pieces
     t = np.linspace(0, 1, 33)[:, None]
     curves = [t * [3, 0, 0], [3, 0, 0] + t * [0, 1, 0], [3, 1, 0] - t * [3, 0, 0],
               [0, 1, 0] - t * [0, 1, 0]]

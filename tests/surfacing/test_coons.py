@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from surfacing.coons import coons_eval, coons_grid, hermite_blend
+from curvenet.surfacing.coons import coons_eval, coons_grid, hermite_blend
 
 
 def _sides(p, q, f):

@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 
 from curvenet import shapes
-from surfacing.controlmesh import build_control_mesh
-from surfacing.creases import dihedral_angles, sharp_structure
+from curvenet.surfacing.controlmesh import build_control_mesh
+from curvenet.surfacing.creases import dihedral_angles, sharp_structure
 
 
 def _cm(name):

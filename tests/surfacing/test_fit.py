@@ -2,12 +2,12 @@ import numpy as np
 import pytest
 
 from curvenet import shapes
-from surfacing.catmull_clark import edge_topology
-from surfacing.controlmesh import build_control_mesh
-from surfacing.creases import sharp_structure
-from surfacing.fit import (fairness_matrix, fit_iterative, fit_lsq, variation_matrix,
+from curvenet.surfacing.catmull_clark import edge_topology
+from curvenet.surfacing.controlmesh import build_control_mesh
+from curvenet.surfacing.creases import sharp_structure
+from curvenet.surfacing.fit import (fairness_matrix, fit_iterative, fit_lsq, variation_matrix,
                            vspring_displacement)
-from surfacing.limit import limit_matrix, tangent_matrices
+from curvenet.surfacing.limit import limit_matrix, tangent_matrices
 
 
 def _setup(name, N=4):

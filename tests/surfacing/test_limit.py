@@ -2,10 +2,10 @@ import numpy as np
 import pytest
 
 from curvenet import shapes
-from surfacing.catmull_clark import edge_index, subdivide, subdivision_step
-from surfacing.controlmesh import build_control_mesh
-from surfacing.creases import sharp_structure
-from surfacing.limit import limit_matrix, limit_normals, tangent_matrices
+from curvenet.surfacing.catmull_clark import edge_index, subdivide, subdivision_step
+from curvenet.surfacing.controlmesh import build_control_mesh
+from curvenet.surfacing.creases import sharp_structure
+from curvenet.surfacing.limit import limit_matrix, limit_normals, tangent_matrices
 
 from ._meshes import cube, grid
 
@@ -113,7 +113,7 @@ def test_tangent_masks_are_tangent_to_the_limit_surface():
     # compare with the normal of the subdivided limit mesh near each control vertex
     V4, Q4, _, _ = subdivide(V, Q, 4)
     L4 = limit_matrix(Q4, len(V4))
-    from surfacing.limit import quad_vertex_normals
+    from curvenet.surfacing.limit import quad_vertex_normals
     N4 = quad_vertex_normals(L4 @ V4, Q4)[:n]
     cos = np.einsum("ij,ij->i", N, N4)
     # 4 levels: the one-ring of the fine mesh spans 1/16 of a control edge, so the
@@ -125,7 +125,7 @@ def test_tangent_masks_are_tangent_to_the_limit_surface():
 
 def test_limit_normals_fall_back_at_creases():
     V, Q = cube()
-    from surfacing.catmull_clark import edge_topology
+    from curvenet.surfacing.catmull_clark import edge_topology
     se = edge_topology(Q, 8).edges
     T1, T2, has = tangent_matrices(Q, 8, sharp_edges=se)
     assert not has.any()

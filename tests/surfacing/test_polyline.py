@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from surfacing.polyline import (arc_length_params, end_tangents, point_polyline_distance,
+from curvenet.surfacing.polyline import (arc_length_params, end_tangents, point_polyline_distance,
                                 resample, sample_at)
 
 

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from surfacing.sides import group_sides, junction_angles
+from curvenet.surfacing.sides import group_sides, junction_angles
 
 
 def _seg(a, b, n=5):
