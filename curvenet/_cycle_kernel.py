@@ -1,4 +1,4 @@
-"""numba kernel of the cycle enumeration of :class:`curvenet.cycles.CandidatePool`.
+"""numba kernel of the cycle enumeration of :class:`curvenet.candidates.CandidatePool`.
 
 Imported only when the search is deep enough to pay for importing numba; the
 compiled function is cached on disk (``cache=True``). Same search as

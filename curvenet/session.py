@@ -26,8 +26,10 @@ import sys
 from dataclasses import dataclass, field
 
 from ._gf2 import bitset_solve, edge_mask, gf2_rank, gf2_solve
-from .cycles import (DEFAULT_MAX_WORK, CandidatePool, TIE_BREAKS, closing_suggestions)
+from .candidates import DEFAULT_MAX_WORK, TIE_BREAKS, CandidatePool
+from .closing import closing_suggestions
 from .errors import InvalidParameterError, NetworkError
+from .loops import cycle_to_loop
 from .patchset import Patch, PatchSet, save_patchset
 
 __all__ = ["Suggestion", "PatchSession", "run_interactive"]
@@ -89,7 +91,7 @@ class PatchSession:
     backend : {"galois", "bitset"}
         GF(2) solver for the suggestions.
     max_work : int
-        Enumeration budget for candidate cycles (see :class:`~curvenet.cycles.CandidatePool`).
+        Enumeration budget for candidate cycles (see :class:`~curvenet.candidates.CandidatePool`).
 
     Notes
     -----
@@ -133,7 +135,6 @@ class PatchSession:
             if found is None:
                 break
             cands.extend(found)
-        self.pool.all_candidates = cands
         self._by_edges = {c.edges: c for c in cands}
 
     # --- state ----------------------------------------------------------------
@@ -241,7 +242,6 @@ class PatchSession:
                              else map(int, suggestion)))
         if edges in {p.edges for p in self._patches}:
             raise InvalidParameterError(f"suggestion: {list(edges)} is already a patch")
-        from .cycles import cycle_to_loop
         cycle_to_loop(self.network, edges)  # raises NetworkError if not a simple loop
         kind = suggestion.kind if isinstance(suggestion, Suggestion) else "user"
         self._push()

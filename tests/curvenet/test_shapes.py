@@ -6,7 +6,7 @@ import pytest
 import trimesh
 
 from curvenet import shapes
-from curvenet.cycles import _signed_volume
+from curvenet.loops import signed_volume
 
 
 @pytest.mark.parametrize("name", sorted(shapes.SHAPES))
@@ -32,7 +32,7 @@ def test_shape_is_consistent(name):
     else:
         assert chi == 1
     if s.closed and name != "two_boxes":
-        assert _signed_volume(net, s.faces) > 0
+        assert signed_volume(net, s.faces) > 0
     # curve samples lie on the reference surface (chord error of the reference only)
     ref = s.reference_mesh(5)
     pts = np.concatenate([e.curve for e in net.edges])
