@@ -76,6 +76,17 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--format", default="obj", choices=("obj", "ply", "stl", "off", "glb"),
                    help="mesh format in batch mode (default obj)")
     s.add_argument("--jobs", type=_positive_int, default=1, help="batch: parallel processes")
+    s.add_argument("--scheduler", metavar="ADDRESS",
+                   help="batch: send the files to this Dask scheduler (tcp://host:8786) "
+                        "instead of local processes; needs curvenet[cluster]")
+    s.add_argument("--skip-existing", action="store_true",
+                   help="batch: skip files already surfaced with the same input and "
+                        "settings (from OUT_DIR/curvenet-manifest.jsonl); resumes a batch")
+    s.add_argument("--report", metavar="REPORT.csv|json",
+                   help="batch: per-file report (hash, route, times, patches, coverage, "
+                        "stroke fidelity, output, status)")
+    s.add_argument("--preview-dir", metavar="DIR",
+                   help="batch: a picture per file and contact_sheet.png of the batch")
     s.add_argument("--method", choices=("auto", "classical", "neural"), default="auto")
     s.add_argument("--patches", metavar="PATCHES.json", help="use this (edited) patch set")
     s.add_argument("--snap-tol", type=_fraction)
@@ -102,11 +113,18 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--no-progress", action="store_true", help="hide progress bars")
 
     s = sub.add_parser("eval", help="compare a mesh with a reference mesh or the sketch")
-    s.add_argument("mesh")
-    s.add_argument("reference", help="reference mesh, or a sketch file for stroke distance")
+    s.add_argument("mesh", nargs="?")
+    s.add_argument("reference", nargs="?",
+                   help="reference mesh, or a sketch file for stroke distance")
+    s.add_argument("--pairs", nargs="+", metavar="DIR_OUT DIR_REF | PAIRS.csv",
+                   help="batch: every mesh in DIR_OUT against the file of the same stem in "
+                        "DIR_REF, or the mesh,reference rows of a CSV")
+    s.add_argument("--report", metavar="REPORT.csv|json",
+                   help="batch: write the table with the metric definitions in its header")
     s.add_argument("--json", action="store_true", help="print JSON")
     s.add_argument("--samples", type=_positive_int, default=100_000)
     s.add_argument("--threshold", type=float, default=0.01, help="F-score threshold")
+    s.add_argument("--seed", type=int, default=0, help="seed of the surface sampling")
     return p
 
 
@@ -182,83 +200,148 @@ def _surface_one(inp: str, out: str, args) -> dict:
 
 def _cmd_surface(args) -> int:
     from .pipeline import MESH_FORMATS
-    if args.out_dir is None:
-        if args.output is None:
-            raise InvalidParameterError("surface: give -o MESH (one input) or --out-dir DIR")
-        if len(args.inputs) > 1:
-            raise InvalidParameterError("surface: several inputs need --out-dir DIR, not -o")
-        if Path(args.output).suffix.lower() not in MESH_FORMATS:
-            raise InvalidParameterError(f"output {args.output}: unknown mesh format; use one "
-                                        f"of {', '.join(MESH_FORMATS)}")
-        jobs = [(args.inputs[0], args.output)]
-    else:
-        out_dir = Path(args.out_dir)
-        out_dir.mkdir(parents=True, exist_ok=True)
-        jobs = [(i, str(out_dir / f"{Path(i).stem}.{args.format}")) for i in args.inputs]
-    if len(jobs) == 1:
-        row = _surface_one(*jobs[0], args)
-        if row["status"] != "ok":
-            raise CurvenetError(row["error"])
-        print(f"{row['output']}: {row['faces']} faces, {row['method']}, {row['seconds']:.1f} s")
-        if args.explain:
-            print(f"route: {row['why']}")
-        return 0
-    args.no_progress = True
-    if args.jobs > 1:
-        from concurrent.futures import ProcessPoolExecutor
-        with ProcessPoolExecutor(max_workers=args.jobs) as pool:
-            futures = [pool.submit(_surface_one, i, o, args) for i, o in jobs]
-            rows = []
-            for f in futures:
-                rows.append(f.result())
-                _print_row(rows[-1], args.explain)
-    else:
-        rows = []
-        for i, o in jobs:
-            rows.append(_surface_one(i, o, args))
-            _print_row(rows[-1], args.explain)
-    ok = sum(r["status"] == "ok" for r in rows)
-    print(f"{ok} of {len(rows)} surfaced, {len(rows) - ok} failed, "
-          f"{sum(r['seconds'] for r in rows):.1f} s in all")
-    return 0 if ok == len(rows) else 2
+    if args.out_dir is not None:
+        return _cmd_surface_batch(args)
+    for flag in ("scheduler", "report", "preview_dir", "skip_existing"):
+        if getattr(args, flag) not in (None, False):
+            raise InvalidParameterError(f"surface: --{flag.replace('_', '-')} needs --out-dir")
+    if args.output is None:
+        raise InvalidParameterError("surface: give -o MESH (one input) or --out-dir DIR")
+    if len(args.inputs) > 1:
+        raise InvalidParameterError("surface: several inputs need --out-dir DIR, not -o")
+    if Path(args.output).suffix.lower() not in MESH_FORMATS:
+        raise InvalidParameterError(f"output {args.output}: unknown mesh format; use one "
+                                    f"of {', '.join(MESH_FORMATS)}")
+    row = _surface_one(args.inputs[0], args.output, args)
+    if row["status"] != "ok":
+        raise CurvenetError(row["error"])
+    print(f"{row['output']}: {row['faces']} faces, {row['method']}, {row['seconds']:.1f} s")
+    if args.explain:
+        print(f"route: {row['why']}")
+    return 0
 
 
-def _print_row(row: dict, explain: bool) -> None:
-    if row["status"] == "ok":
-        line = f"ok     {row['input']} -> {row['output']}  {row['method']:<10s} " \
-               f"{row['faces']:>8d} faces {row['seconds']:7.1f} s"
-        if explain:
-            line += f"  ({row['why']})"
+def _batch_options(args):
+    from .batch import BatchOptions
+    return BatchOptions(method=args.method, snap_tol=args.snap_tol, close=args.close,
+                        surfacer=args.surfacer, subdiv=args.subdiv, resolution=args.resolution,
+                        crease_angle=args.crease_angle, refine=args.refine,
+                        quality=args.quality, device=args.device, seed=args.seed,
+                        neural_options=tuple(sorted((_neural_options(args) or {}).items())),
+                        format=args.format)
+
+
+def _progress(total: int, quiet: bool):
+    """A tqdm bar across files on a terminal (None elsewhere: the per-file lines suffice)."""
+    if quiet or not sys.stderr.isatty():
+        return None
+    from tqdm import tqdm
+    return tqdm(total=total, unit="file", file=sys.stderr, leave=False)
+
+
+def _cmd_surface_batch(args) -> int:
+    """``--out-dir``: the batch engine (:mod:`curvenet.batch`), one line per file."""
+    from .batch import DaskExecutor, LocalExecutor, run_batch
+    from .tables import check_report_path, write_table
+    if args.output is not None:
+        raise InvalidParameterError("surface: give -o MESH or --out-dir DIR, not both")
+    if args.patches is not None:
+        raise InvalidParameterError("surface: --patches applies to one input with -o, "
+                                    "not to a batch")
+    report = None if args.report is None else check_report_path(args.report)
+    executor = DaskExecutor(args.scheduler) if args.scheduler else LocalExecutor(args.jobs)
+    options = _batch_options(args)
+    bar = _progress(len(args.inputs), args.no_progress)
+    say = print if bar is None else bar.write
+
+    def on_row(row, done, total):
+        if bar is not None:
+            bar.update(1)
+        say(_batch_line(row, done, total, args.explain))
+
+    try:
+        result = run_batch(args.inputs, args.out_dir, options, executor=executor,
+                           skip_existing=args.skip_existing, preview=args.preview is not None,
+                           preview_dir=args.preview_dir, up=args.up, on_row=on_row)
+    finally:
+        if bar is not None:
+            bar.close()
+    summary = result.summary()
+    if report is not None:
+        header = [f"curvenet surface batch: {len(result.rows)} files, executor "
+                  f"{'dask ' + args.scheduler if args.scheduler else f'local, {args.jobs} jobs'}",
+                  f"settings: {options}",
+                  "fidelity: share of stroke length within 1% of the surface's bbox diagonal; "
+                  "fidelity_median / fidelity_p95: stroke-to-surface distance / that diagonal",
+                  "t_*: seconds per stage on the worker"]
+        write_table(report, result.rows, header=header, summary=summary,
+                    first=("input", "status", "route", "output", "input_sha256"))
+    print(summary)
+    return result.exit_code
+
+
+def _batch_line(row: dict, done: int, total: int, explain: bool) -> str:
+    head = f"[{done}/{total}] "
+    if row["status"] in ("ok", "skipped"):
+        fid = row.get("fidelity")
+        line = (f"{head}{row['status']:<7s} {row['input']} -> {row['output']}  "
+                f"{row.get('route', ''):<10s} {row.get('faces', 0):>8d} faces"
+                + ("" if fid is None else f"  fidelity {fid:.1%}")
+                + f" {row.get('t_total', 0.0):7.1f} s")
+        return line + (f"  ({row.get('decision', '')})" if explain else "")
+    return f"{head}FAILED  {row['input']}: {row.get('error', '')}"
+
+
+def _cmd_eval_pairs(args) -> int:
+    """``eval --pairs``: a table over many pairs, metric definitions in the report header."""
+    from . import batch_eval as be
+    from .tables import check_report_path, write_table
+    if args.mesh is not None:
+        raise InvalidParameterError("eval: give MESH REFERENCE or --pairs, not both")
+    report = None if args.report is None else check_report_path(args.report)
+    if len(args.pairs) == 1:
+        pairs = be.pairs_from_csv(args.pairs[0])
+    elif len(args.pairs) == 2:
+        pairs = be.pairs_from_dirs(*args.pairs)
     else:
-        line = f"FAILED {row['input']}: {row['error']}"
-    print(line, flush=True)
+        raise InvalidParameterError("eval: --pairs takes DIR_OUT DIR_REF or one PAIRS.csv")
+    header = be.metric_definitions(args.samples, args.threshold, args.seed)
+    bar = _progress(len(pairs), False)
+    rows = be.evaluate_pairs(pairs, n_samples=args.samples, threshold=args.threshold,
+                             seed=args.seed,
+                             on_row=None if bar is None else lambda *_: bar.update(1))
+    if bar is not None:
+        bar.close()
+    summary = be.summary_line(rows)
+    if report is not None:
+        write_table(report, rows, header=header, summary=summary,
+                    first=("mesh", "reference", "status", "kind"))
+    if args.json:
+        print(json.dumps({"header": header, "rows": rows, "summary": summary}, indent=1))
+    else:
+        print("\n".join(f"# {line}" for line in header))
+        print(be.format_table(rows))
+        print(summary)
+    return 1 if any(r["status"] == "internal" for r in rows) else (
+        2 if any(r["status"] != "ok" for r in rows) else 0)
 
 
 def _cmd_eval(args) -> int:
+    from .batch_eval import is_mesh_file
     from .evaluate import evaluate_mesh, format_report, stroke_distance
-    from .pipeline import MESH_FORMATS
+    if args.pairs is not None:
+        return _cmd_eval_pairs(args)
+    if args.mesh is None or args.reference is None:
+        raise InvalidParameterError("eval: give MESH REFERENCE, or --pairs")
     ref = Path(args.reference)
-    is_mesh = ref.suffix.lower() in MESH_FORMATS and (ref.suffix.lower() != ".obj"
-                                                       or _is_mesh_obj(ref))
-    if is_mesh:
+    if is_mesh_file(ref):
         metrics = evaluate_mesh(args.mesh, args.reference, n_samples=args.samples,
-                                threshold=args.threshold)
+                                threshold=args.threshold, seed=args.seed)
     else:
         from .io import read_sketch
         metrics = stroke_distance(args.mesh, read_sketch(ref))
     print(json.dumps(metrics, indent=2) if args.json else format_report(metrics))
     return 0
-
-
-def _is_mesh_obj(path: Path) -> bool:
-    """An OBJ with ``f`` lines is a mesh; one with only ``l`` lines is a sketch."""
-    if not path.is_file():
-        return False
-    with open(path, "rb") as fh:
-        for raw in fh:
-            if raw.startswith(b"f "):
-                return True
-    return False
 
 
 COMMANDS = {"snap": _cmd_snap, "patches": _cmd_patches, "surface": _cmd_surface,

@@ -22,8 +22,8 @@ import numpy as np
 
 from .errors import InvalidParameterError, SketchFormatError
 
-__all__ = ["evaluate_mesh", "stroke_distance", "format_report", "load_mesh_arrays",
-           "sample_surface", "point_surface_distance"]
+__all__ = ["evaluate_mesh", "stroke_distance", "stroke_fidelity", "format_report",
+           "load_mesh_arrays", "sample_surface", "point_surface_distance"]
 
 #: Relative area below which a triangle counts as degenerate (times the squared bbox diagonal).
 #: Degenerate triangles have no normal and zero sampling probability; they are dropped.
@@ -31,6 +31,9 @@ DEGENERATE_AREA_REL = 1e-14
 
 #: Stroke polylines are resampled with this spacing relative to the sketch's bbox diagonal.
 STROKE_SPACING_REL = 1e-3
+
+#: Stroke fidelity counts stroke length within this fraction of the surface's bbox diagonal.
+FIDELITY_TOL_REL = 0.01
 
 
 # ---------------------------------------------------------------------------
@@ -402,24 +405,7 @@ def stroke_distance(mesh, strokes, *, spacing: float = STROKE_SPACING_REL) -> di
     >>> d["stroke_max"] < 1e-12
     True
     """
-    from .sketch import as_stroke
-
-    if not (isinstance(spacing, (int, float, np.floating)) and math.isfinite(spacing)
-            and spacing > 0):
-        raise InvalidParameterError(f"spacing must be a positive number, got {spacing!r}")
-    lines = [as_stroke(s, name=f"strokes[{i}]") for i, s in enumerate(_stroke_list(strokes))]
-    if not lines:
-        raise InvalidParameterError("strokes: no strokes to measure")
-    v, f = load_mesh_arrays(mesh, name="mesh")
-    allpts = np.concatenate(lines)
-    diag = float(np.linalg.norm(np.ptp(allpts, axis=0)))
-    if not diag > 0:
-        raise InvalidParameterError("strokes: the sketch has zero extent")
-    f, _n, _a = _drop_degenerate(v, f)
-    if len(f) == 0:
-        raise InvalidParameterError("mesh: all triangles have zero area")
-    pts = _resample_polylines(lines, spacing * diag)
-    d, _ = point_surface_distance(pts, v, f)
+    d, diag, _v = _stroke_sample_distances(mesh, strokes, spacing)
     d = d / diag
     return {
         "stroke_mean": float(d.mean()),
@@ -429,6 +415,71 @@ def stroke_distance(mesh, strokes, *, spacing: float = STROKE_SPACING_REL) -> di
         "diagonal": diag,
         "n_stroke_samples": int(len(d)),
     }
+
+
+def _stroke_sample_distances(mesh, strokes, spacing):
+    """Distances from arc-length stroke samples to the mesh (input units).
+
+    Returns ``(d, diag, vertices)``: ``d`` (k,) float64 per sample, ``diag`` the sketch's
+    bounding-box diagonal (samples are ``spacing * diag`` apart), ``vertices`` (V, 3)
+    float64 of the mesh.
+    """
+    from .sketch import as_stroke
+
+    if not (isinstance(spacing, (int, float, np.floating)) and math.isfinite(spacing)
+            and spacing > 0):
+        raise InvalidParameterError(f"spacing must be a positive number, got {spacing!r}")
+    lines = [as_stroke(s, name=f"strokes[{i}]") for i, s in enumerate(_stroke_list(strokes))]
+    if not lines:
+        raise InvalidParameterError("strokes: no strokes to measure")
+    v, f = load_mesh_arrays(mesh, name="mesh")
+    diag = float(np.linalg.norm(np.ptp(np.concatenate(lines), axis=0)))
+    if not diag > 0:
+        raise InvalidParameterError("strokes: the sketch has zero extent")
+    f, _n, _a = _drop_degenerate(v, f)
+    if len(f) == 0:
+        raise InvalidParameterError("mesh: all triangles have zero area")
+    d, _ = point_surface_distance(_resample_polylines(lines, spacing * diag), v, f)
+    return d, diag, v
+
+
+def stroke_fidelity(mesh, strokes, *, tol: float = FIDELITY_TOL_REL,
+                    spacing: float = STROKE_SPACING_REL) -> dict:
+    """How much of the sketch the surface passes through: the batch report's fidelity.
+
+    Parameters
+    ----------
+    mesh : trimesh.Trimesh, (vertices, faces) pair or path
+    strokes : Sketch, CurveNetwork, list of (n, 3) array_like, or path of a sketch file
+        As in :func:`stroke_distance`.
+    tol : float, default 0.01
+        Distance counted as "on the surface", relative to the *surface's* bounding-box
+        diagonal.
+    spacing : float, default 1e-3
+        Arc-length resampling step relative to the sketch's diagonal (as in
+        :func:`stroke_distance`), so the share below is a share of stroke length.
+
+    Returns
+    -------
+    dict
+        ``fidelity`` (share of stroke length within ``tol`` of the surface, in [0, 1]),
+        ``median`` and ``p95`` (stroke-to-surface distance, divided by the surface's
+        diagonal), ``diagonal`` (the surface's bbox diagonal, input units).
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> box = trimesh.creation.box()
+    >>> stroke_fidelity(box, [[[-0.5, -0.5, 0.5], [0.5, -0.5, 0.5]]])["fidelity"]
+    1.0
+    """
+    if not (isinstance(tol, (int, float, np.floating)) and 0 < tol < 1):
+        raise InvalidParameterError(f"tol must be a number in (0, 1), got {tol!r}")
+    d, _sketch_diag, v = _stroke_sample_distances(mesh, strokes, spacing)
+    diag = float(np.linalg.norm(np.ptp(v, axis=0)))
+    d = d / max(diag, np.finfo(float).tiny)
+    return {"fidelity": float(np.mean(d < tol)), "median": float(np.median(d)),
+            "p95": float(np.percentile(d, 95)), "diagonal": diag}
 
 
 # ---------------------------------------------------------------------------
