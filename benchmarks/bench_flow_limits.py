@@ -194,7 +194,8 @@ class _Oracle:
         import trimesh
 
         from curvenet.neural.extract import marching_cubes_world
-        from curvenet.neural.poisson import interpolate, normalize_scale_shift, normalize_splat, splat
+        from curvenet.neural.poisson import (interpolate, normalize_scale_shift,
+                                             normalize_splat, splat)
 
         surf = self.frame.to_unit(trimesh.sample.sample_surface(self.ref, n_surface, seed=1)[0])
         pts = torch.tensor(np.vstack([self.xs, surf]))

@@ -7,7 +7,8 @@ import torch
 
 from curvenet.neural.geometry import (alignment_cos4, covariant_tv, curl, directional_derivative_II,
                              principal_curvatures, second_fundamental_form, tangent_frame)
-from curvenet.neural.losses import alignment_loss, curl_loss, smoothness_loss, smoothness_loss_autograd
+from curvenet.neural.losses import (alignment_loss, curl_loss, smoothness_loss,
+                                    smoothness_loss_autograd)
 from curvenet.neural.siren import GradientSiren
 
 D = torch.float64

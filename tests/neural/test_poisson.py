@@ -5,8 +5,8 @@ import math
 import pytest
 import torch
 
-from curvenet.neural.poisson import (PoissonSolver, interpolate, normalize_scale_shift, normalize_splat,
-                            splat)
+from curvenet.neural.poisson import (PoissonSolver, interpolate, normalize_scale_shift,
+                                     normalize_splat, splat)
 
 
 def _grid(n, dtype=torch.float64):

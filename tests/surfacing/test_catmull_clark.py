@@ -2,8 +2,8 @@ import numpy as np
 import pytest
 import trimesh
 
-from curvenet.surfacing.catmull_clark import (edge_index, edge_topology, euler_characteristic, subdivide,
-                                     subdivision_step)
+from curvenet.surfacing.catmull_clark import (edge_index, edge_topology, euler_characteristic,
+                                              subdivide, subdivision_step)
 
 from ._meshes import cube, grid
 

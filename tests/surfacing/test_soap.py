@@ -2,7 +2,8 @@ import numpy as np
 import pytest
 
 from curvenet.surfacing.polyline import arc_length_params
-from curvenet.surfacing.soap import _cotan_laplacian, disk_triangulation, soapfilm_mesh, soapfilm_patch
+from curvenet.surfacing.soap import (_cotan_laplacian, disk_triangulation, soapfilm_mesh,
+                                     soapfilm_patch)
 
 
 def test_disk_triangulation_border_and_orientation():
