@@ -12,6 +12,7 @@ __all__ = [
     "InvalidParameterError",
     "NetworkError",
     "MissingDependencyError",
+    "OutputError",
 ]
 
 
@@ -62,3 +63,9 @@ class NetworkError(CurvenetError):
 
 class MissingDependencyError(CurvenetError, ImportError):
     """An optional feature needs a package that is not installed."""
+
+
+class OutputError(CurvenetError):
+    """An output cannot be written where asked: missing or read-only folder, the path is
+    one of the inputs, or the write failed (disk full). The message names the requested
+    path, never a temporary file."""

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 from ._gf2 import bitset_solve, edge_mask, gf2_rank, gf2_solve
 from .candidates import DEFAULT_MAX_WORK, TIE_BREAKS, CandidatePool
 from .closing import closing_suggestions
-from .errors import InvalidParameterError, NetworkError
+from .errors import InvalidParameterError, NetworkError, OutputError
 from .loops import cycle_to_loop
 from .patchset import Patch, PatchSet, save_patchset
 
@@ -378,7 +378,7 @@ def run_interactive(patchset: PatchSet, *, input=sys.stdin, output=sys.stdout, p
             try:
                 session.save(path)
                 output.write(f"  saved {path}\n")
-            except (OSError, NetworkError) as err:
+            except (OSError, NetworkError, OutputError) as err:
                 output.write(f"  cannot save {path!r}: {err}\n")
         else:
             output.write(_HELP + "\n")

@@ -32,14 +32,21 @@ def count_colour(img, rgb, tol=0.03):
     return int(np.all(np.abs(img - np.asarray(rgb)) < tol, axis=-1).sum())
 
 
+def test_missing_folder_is_an_error_not_created(tmp_path):
+    from curvenet.errors import OutputError
+    with pytest.raises(OutputError, match="does not exist"):
+        render_preview(tmp_path / "sub" / "sphere.png", mesh=trimesh.creation.icosphere())
+    assert not (tmp_path / "sub").exists()
+
+
 def true_patchset(shape):
     return PatchSet(shape.network, [Patch(edges=[e for e, _ in loop]) for loop in shape.faces])
 
 
 def test_sphere_mesh_picture(tmp_path):
-    out = render_preview(tmp_path / "sub" / "sphere.png",
+    out = render_preview(tmp_path / "sphere.png",
                          mesh=trimesh.creation.icosphere(subdivisions=3), size=(400, 300))
-    assert out == tmp_path / "sub" / "sphere.png"
+    assert out == tmp_path / "sphere.png"
     img = read_png(out)
     assert img.shape == (300, 400, 3)
     mask = non_white(img)
