@@ -64,6 +64,10 @@ FORMATS = ("obj", "curves", "txt", "json")
 
 #: Largest file :func:`read_sketch` accepts by default (1 GiB); pass ``max_bytes`` to change.
 MAX_FILE_BYTES = 1 << 30
+_CHUNK_BYTES = 1 << 24
+
+#: Largest coordinate magnitude accepted: squared distances of larger ones overflow float64.
+MAX_ABS_COORDINATE = 1e150
 
 _EXTENSIONS = {".obj": "obj", ".curves": "curves", ".txt": "txt", ".xyz": "txt",
                ".json": "json"}
@@ -72,24 +76,36 @@ _LABEL_RE = re.compile(r"#\s*label\s*:\s*(\w+)", re.IGNORECASE)
 
 # --------------------------------------------------------------------------- helpers
 def _load_text(path, max_bytes: int) -> str:
-    """Read ``path`` as UTF-8 text, rejecting empty, huge, binary and non-UTF-8 files."""
+    """Read ``path`` as UTF-8 text, rejecting empty, huge, binary and non-UTF-8 files.
+
+    The read itself is bounded (in chunks, at most ``max_bytes + 1`` bytes), so a
+    device or a pipe (``/dev/zero``, whose ``stat`` size is 0) is refused too.
+    """
     p = Path(path)
-    try:
-        size = p.stat().st_size
-    except OSError as err:
-        raise SketchFormatError(f"cannot read file: {err.strerror}", path=path) from None
     if p.is_dir():
         raise SketchFormatError("is a directory, not a sketch file", path=path)
-    if size > max_bytes:
-        raise SketchFormatError(f"file is {size} bytes, larger than the limit of {max_bytes} "
+    chunks, total = [], 0
+    try:
+        with open(p, "rb") as fh:
+            while total <= max_bytes:
+                chunk = fh.read(min(_CHUNK_BYTES, max_bytes + 1 - total))
+                if not chunk:
+                    break
+                nul = chunk.find(b"\x00")
+                if nul >= 0:
+                    line = sum(c.count(b"\n") for c in chunks) + chunk.count(b"\n", 0, nul) + 1
+                    raise SketchFormatError("binary data (NUL byte), not a text sketch",
+                                            path=path, line=line)
+                chunks.append(chunk)
+                total += len(chunk)
+    except OSError as err:
+        raise SketchFormatError(f"cannot read file: {err.strerror or err}", path=path) from None
+    if total > max_bytes:
+        raise SketchFormatError(f"file is larger than the limit of {max_bytes} bytes "
                                 "(pass max_bytes= to raise it)", path=path)
-    data = p.read_bytes()
+    data = b"".join(chunks)
     if not data.strip():
         raise SketchFormatError("empty file", path=path)
-    nul = data.find(b"\x00")
-    if nul >= 0:
-        raise SketchFormatError("binary data (NUL byte), not a text sketch", path=path,
-                                line=data.count(b"\n", 0, nul) + 1)
     try:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as err:
@@ -154,8 +170,14 @@ def _finish(strokes, labels, lines, path, strict, metadata=None) -> Sketch:
     if not keep_s:
         raise SketchFormatError("no strokes with at least two points" if warns else
                                 "no strokes", path=path)
-    for w in warns:
-        warnings.warn(f"{path}: {w} (dropped)", stacklevel=3)
+    big = max(float(np.abs(s).max()) for s in keep_s)
+    if big > MAX_ABS_COORDINATE:
+        raise SketchFormatError(f"coordinates up to {big:.3g} in size: lengths would overflow "
+                                f"(the limit is {MAX_ABS_COORDINATE:.0e}; rescale the sketch)",
+                                path=path)
+    if warns:
+        more = f" and {len(warns) - 1} more" if len(warns) > 1 else ""
+        warnings.warn(f"{path}: {warns[0]}{more} (dropped)", stacklevel=3)
     meta = dict(metadata or {})
     if warns:
         meta.setdefault("warnings", []).extend(warns)
@@ -433,6 +455,10 @@ def _read_json(text, path, strict):
         data = json.loads(text)
     except json.JSONDecodeError as err:
         raise SketchFormatError(f"invalid JSON: {err.msg}", path=path, line=err.lineno) from None
+    except RecursionError:
+        raise SketchFormatError("invalid JSON: nested too deeply", path=path) from None
+    except ValueError as err:  # e.g. an integer literal longer than Python's digit limit
+        raise SketchFormatError(f"invalid JSON: {err}", path=path) from None
     if not isinstance(data, dict) or data.get("format") != "curvenet.sketch":
         raise SketchFormatError("not a curvenet.sketch JSON file (missing "
                                 "\"format\": \"curvenet.sketch\")", path=path)
@@ -451,6 +477,9 @@ def _read_json(text, path, strict):
             arr = np.asarray(pts, dtype=np.float64)
         except (TypeError, ValueError):
             raise SketchFormatError(f"strokes[{i}]: points are not numbers", path=path) from None
+        except OverflowError:
+            raise SketchFormatError(f"strokes[{i}]: a coordinate is too large for a float",
+                                    path=path) from None
         if arr.size == 0:
             arr = arr.reshape(0, 3)
         if arr.ndim != 2 or arr.shape[1] != 3:
