@@ -70,9 +70,13 @@ def load_mesh_arrays(mesh, *, name: str = "mesh") -> tuple[np.ndarray, np.ndarra
         import trimesh
 
         try:
-            loaded = trimesh.load(str(path), force="mesh")
+            # process=False: trimesh's clean-up would drop NaN vertices before the check below
+            loaded = trimesh.load(str(path), force="mesh", process=False)
         except Exception as err:  # trimesh raises many types (ValueError, KeyError, ...)
-            raise SketchFormatError(f"cannot read mesh: {err}", path=path) from None
+            # an ImportError here is trimesh guessing a text encoding, not a missing feature
+            why = "" if isinstance(err, ImportError) else f" ({err})"
+            kind = path.suffix.lstrip(".").upper() or "mesh"
+            raise SketchFormatError(f"not a readable {kind} mesh{why}", path=path) from None
         if not hasattr(loaded, "faces") or len(loaded.faces) == 0:
             raise SketchFormatError("no triangles in mesh file", path=path)
         vertices, faces = loaded.vertices, loaded.faces
@@ -286,6 +290,7 @@ def evaluate_mesh(mesh, reference, *, n_samples: int = 100_000, threshold: float
         raise InvalidParameterError("reference: bounding box has zero extent")
     scale = 1.0 / longest
     centre = 0.5 * (lo + hi)
+    size_ratio = _size_ratio(v1[f1.ravel()], longest)
     v1 = (v1 - centre) * scale
     v2 = (v2 - centre) * scale
     f1, n1, a1 = _drop_degenerate(v1, f1)
@@ -293,8 +298,21 @@ def evaluate_mesh(mesh, reference, *, n_samples: int = 100_000, threshold: float
     for name, f in (("mesh", f1), ("reference", f2)):
         if len(f) == 0:
             raise InvalidParameterError(f"{name}: all triangles have zero area")
-    return _evaluate_impl(v1, f1, n1, a1, v2, f2, n2, a2, int(n_samples), float(threshold),
-                          np.random.default_rng(seed), scale)
+    metrics = _evaluate_impl(v1, f1, n1, a1, v2, f2, n2, a2, int(n_samples), float(threshold),
+                             np.random.default_rng(seed), scale)
+    if not (1 / UNIT_MISMATCH_RATIO <= size_ratio <= UNIT_MISMATCH_RATIO):
+        metrics["warnings"] = [f"the mesh is {size_ratio:.3g}x the size of the reference "
+                               "(longest bounding-box side): different units?"]
+    return metrics
+
+
+#: ``evaluate_mesh`` warns when the mesh and the reference differ in size by more than this.
+UNIT_MISMATCH_RATIO = 10.0
+
+
+def _size_ratio(points, reference_longest: float) -> float:
+    """Longest bounding-box side of ``points (n, 3)`` over the reference's."""
+    return float(np.max(points.max(axis=0) - points.min(axis=0))) / reference_longest
 
 
 def _evaluate_impl(v1, f1, n1, a1, v2, f2, n2, a2, n, r, rng, scale) -> dict:
