@@ -61,6 +61,13 @@ class SurfaceResult:
     timings: dict = field(default_factory=dict)
     diagnostics: dict = field(default_factory=dict)
 
+    @property
+    def interrupted(self) -> bool:
+        """True when a fit was stopped with Ctrl-C: the mesh is the best surface so far."""
+        neural = self.diagnostics.get("neural", {})
+        return bool(neural.get("interrupted")
+                    or neural.get("creases", {}).get("interrupted"))
+
     def save(self, path) -> Path:
         """Write the mesh atomically; the format follows the extension."""
         return write_mesh(path, self.mesh)
@@ -156,6 +163,32 @@ def patches(source, *, snap_tol: float | None = None, close: str = "auto",
     timings["patches"] = time.perf_counter() - t
     ps.report.setdefault("timings", {}).update(timings)
     return ps
+
+
+#: A patch set matches a sketch when nearly all stroke points and curve points lie within
+#: this fraction of the sketch's diagonal of the other (snapping moves points far less)...
+PATCHES_MATCH_TOL = 0.1
+#: ...all but this share of them (trimmed overshoots and dropped strokes lie farther).
+PATCHES_MATCH_OUTLIERS = 0.1
+
+
+def _check_patches_match(sketch: Sketch, ps: PatchSet) -> None:
+    """Refuse a patch set whose network was not made from ``sketch``."""
+    from scipy.spatial import cKDTree
+    net = ps.network
+    strokes = np.concatenate(sketch.select(("boundary", "crease")).strokes or sketch.strokes)
+    curves = (np.concatenate([e.curve for e in net.edges]) if net.edges
+              else np.asarray(net.vertices, np.float64).reshape(-1, 3))
+    diag = float(np.linalg.norm(strokes.max(axis=0) - strokes.min(axis=0)))
+    if len(curves) == 0 or not diag > 0:
+        return
+    far = max(float(np.mean(cKDTree(curves).query(strokes)[0] > PATCHES_MATCH_TOL * diag)),
+              float(np.mean(cKDTree(strokes).query(curves)[0] > PATCHES_MATCH_TOL * diag)))
+    if far > PATCHES_MATCH_OUTLIERS:
+        raise InvalidParameterError(
+            f"the patch set's network does not match the sketch {sketch.source or ''}: "
+            f"{far:.0%} of the points lie farther than {PATCHES_MATCH_TOL:.0%} of the diagonal "
+            "from the other (were the patches made from another sketch?)")
 
 
 def _coverage(ps: PatchSet) -> tuple[float, list]:
@@ -291,6 +324,12 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
         raise InvalidParameterError(f"crease_angle: {crease_angle!r} is not in (0, 180)")
     if device not in ("cpu", "cuda") and not str(device).startswith("cuda:"):
         raise InvalidParameterError(f"device: {device!r} is not cpu or cuda")
+    if neural_options:
+        from curvenet.neural.presets import get_config
+        try:
+            get_config(quality, **neural_options)
+        except ValueError as err:
+            raise InvalidParameterError(f"neural_options: {err}") from err
     if crease_options:
         from curvenet.neural.creases import crease_config
         try:
@@ -302,6 +341,8 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
     sketch, given = load_source(source)
     if patchset is not None:
         given = patchset
+        if sketch is not None:
+            _check_patches_match(sketch, patchset)
     if sketch is not None and len(sketch.select(("boundary", "crease"))) == 0:
         raise InvalidParameterError(f"{sketch.source or 'sketch'}: no boundary or crease strokes")
 

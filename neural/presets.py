@@ -211,6 +211,10 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
             raise ValueError(f"{name} must be a non-negative integer, got {v!r}")
     if cfg.res < 8:
         raise ValueError(f"res must be at least 8, got {cfg.res}")
+    if cfg.res > MAX_RES:
+        need = GRID_BYTES_PER_VOXEL * cfg.res ** 3 / 2**30
+        raise ValueError(f"res {cfg.res} needs about {need:.3g} GiB for its grids; "
+                         f"the limit is res <= {MAX_RES}")
     for name in ("padding", "lr", "sigma", "omega_0"):
         if not getattr(cfg, name) > 0:
             raise ValueError(f"{name} must be positive, got {getattr(cfg, name)!r}")
@@ -223,6 +227,12 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
         if getattr(cfg, name) not in allowed:
             raise ValueError(f"{name} must be one of {allowed}, got {getattr(cfg, name)!r}")
     return cfg
+
+
+#: Largest Poisson grid accepted (``res``); larger grids are refused before any allocation.
+MAX_RES = 512
+#: Rough bytes per grid voxel of a fit (float32 field, FFT buffers, splats), for the message.
+GRID_BYTES_PER_VOXEL = 40
 
 
 def parse_setting(text: str) -> tuple[str, object]:

@@ -72,6 +72,24 @@ def _quads_to_tris(q: np.ndarray) -> np.ndarray:
     return np.concatenate([q[:, [0, 1, 2]], q[:, [0, 2, 3]]]).astype(np.int64)
 
 
+#: Largest output ``surface_loops`` accepts, in triangles (estimated before any allocation).
+MAX_OUTPUT_FACES = 20_000_000
+
+
+def _check_output_size(n_loops: int, resolution: int, subdiv: int) -> None:
+    """Refuse settings whose output would not fit in memory, before building anything.
+
+    A four-sided patch with one piece per side gives ``2 * r**2 * 4**subdiv`` triangles
+    (``r`` = resolution rounded up to even), so this is a lower bound.
+    """
+    r = int(resolution) + int(resolution) % 2
+    faces = 2 * max(n_loops, 1) * r * r * 4 ** subdiv
+    if faces > MAX_OUTPUT_FACES:
+        raise ValueError(f"resolution {resolution} with subdiv {subdiv} would write at least "
+                         f"{faces:.3g} triangles for {n_loops} patches; the limit is "
+                         f"{MAX_OUTPUT_FACES:.3g} (lower --resolution or --subdiv)")
+
+
 def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None =
                   DEFAULT_CREASE_ANGLE, resolution: int = DEFAULT_RESOLUTION,
                   subdiv: int = DEFAULT_SUBDIV, fit: str = "lsq", update_curves=False,
@@ -155,6 +173,7 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
         raise ValueError(f"fit: expected 'lsq' or 'iterative', got {fit!r}")
     if int(subdiv) != subdiv or subdiv < 0:
         raise ValueError(f"subdiv: expected an integer >= 0, got {subdiv!r}")
+    _check_output_size(len(loops), resolution, int(subdiv))
     if fairness not in FAIRNESS:
         raise ValueError(f"fairness: expected one of {FAIRNESS}, got {fairness!r}")
     if not tol > 0:
