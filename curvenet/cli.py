@@ -9,11 +9,13 @@ from __future__ import annotations
 
 import argparse
 import json
+import signal
 import sys
 import time
 from pathlib import Path
 
-from .errors import CurvenetError, InvalidParameterError
+from ._atomic import check_output_path
+from .errors import CurvenetError, InvalidParameterError, OutputError
 
 __all__ = ["main", "build_parser"]
 
@@ -47,9 +49,25 @@ def _positive_int(text: str) -> int:
     return value
 
 
+def _seed(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
+    if not (0 <= value < 2**63):
+        raise argparse.ArgumentTypeError(f"{text} is not in [0, 2**63)")
+    return value
+
+
+class _Parser(argparse.ArgumentParser):
+    """An option error is one line and a hint, not the usage block."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="curvenet",
-                                description="3D sketches and curve networks to surfaces.")
+    p = _Parser(prog="curvenet", description="3D sketches and curve networks to surfaces.")
     p.add_argument("--debug", action="store_true", help="show tracebacks on errors")
     sub = p.add_subparsers(dest="command", required=True)
 
@@ -106,7 +124,7 @@ def build_parser() -> argparse.ArgumentParser:
                    metavar="NAME=VALUE",
                    help="override one neural setting (neural.presets.FlowConfig), repeatable: "
                         "--neural-set res=96 --neural-set w_smooth=0.01")
-    s.add_argument("--seed", type=int, default=0)
+    s.add_argument("--seed", type=_seed, default=0)
     s.add_argument("--preview", metavar="PNG", help="write a picture of the result")
     s.add_argument("--up", choices=("x", "y", "z"), default="z", help="up axis of the preview")
     s.add_argument("--explain", action="store_true", help="say which route was taken and why")
@@ -133,8 +151,12 @@ def _cmd_snap(args) -> int:
     from .io import read_sketch, write_network_obj
     from .patchset import save_network
     from .snap import snap
+    check_output_path(args.output, inputs=[args.input], what="-o")
     sketch = read_sketch(args.input)
     net = snap(sketch, **({} if args.snap_tol is None else {"snap_tol": args.snap_tol}))
+    if net.number_of_edges == 0:
+        raise CurvenetError(f"{args.input}: snapping left no curves (every stroke collapsed "
+                            "to a point)")
     if args.output.lower().endswith(".obj"):
         write_network_obj(args.output, net)
     else:
@@ -148,6 +170,9 @@ def _cmd_snap(args) -> int:
 def _cmd_patches(args) -> int:
     from .patchset import save_patchset
     from .pipeline import patches
+    check_output_path(args.output, inputs=[args.input], what="-o")
+    if args.preview:
+        check_output_path(args.preview, inputs=[args.input, args.output], what="--preview")
     ps = patches(args.input, snap_tol=args.snap_tol, close=args.close)
     if args.interactive:
         from .session import run_interactive
@@ -192,9 +217,9 @@ def _surface_one(inp: str, out: str, args) -> dict:
                            title=f"{Path(inp).name}: {res.method}", up=args.up)
         return {"input": inp, "output": out, "status": "ok", "method": res.method,
                 "faces": len(res.mesh.faces), "seconds": time.perf_counter() - t0,
-                "why": res.diagnostics.get("decision", "")}
+                "why": res.diagnostics.get("decision", ""), "interrupted": res.interrupted}
     except CurvenetError as err:
-        return {"input": inp, "output": out, "status": "error", "error": str(err),
+        return {"input": inp, "output": out, "status": "error", "error": _naming(err, inp),
                 "seconds": time.perf_counter() - t0}
 
 
@@ -212,13 +237,19 @@ def _cmd_surface(args) -> int:
     if Path(args.output).suffix.lower() not in MESH_FORMATS:
         raise InvalidParameterError(f"output {args.output}: unknown mesh format; use one "
                                     f"of {', '.join(MESH_FORMATS)}")
+    given = [*args.inputs, args.patches]
+    check_output_path(args.output, inputs=given, what="-o")
+    if args.preview:
+        check_output_path(args.preview, inputs=[*given, args.output], what="--preview")
     row = _surface_one(args.inputs[0], args.output, args)
     if row["status"] != "ok":
         raise CurvenetError(row["error"])
-    print(f"{row['output']}: {row['faces']} faces, {row['method']}, {row['seconds']:.1f} s")
+    partial = " (partial: interrupted, the best surface so far)" if row["interrupted"] else ""
+    print(f"{row['output']}: {row['faces']} faces, {row['method']}, "
+          f"{row['seconds']:.1f} s{partial}")
     if args.explain:
         print(f"route: {row['why']}")
-    return 0
+    return 130 if row["interrupted"] else 0
 
 
 def _batch_options(args):
@@ -340,8 +371,31 @@ def _cmd_eval(args) -> int:
     else:
         from .io import read_sketch
         metrics = stroke_distance(args.mesh, read_sketch(ref))
+    for warning in metrics.get("warnings", []):
+        print(f"curvenet eval: warning: {warning}", file=sys.stderr)
     print(json.dumps(metrics, indent=2) if args.json else format_report(metrics))
     return 0
+
+
+def _naming(err: CurvenetError, path) -> str:
+    """The error's message, prefixed with the input file when it does not name it yet."""
+    text = str(err)
+    return text if str(path) in text else f"{path}: {text}"
+
+
+def _terminate(signum, frame):
+    """SIGTERM unwinds like Ctrl-C, so atomic writes remove their temporary files."""
+    raise SystemExit(128 + signum)
+
+
+def _on_sigterm(handler):
+    """Install ``handler`` for SIGTERM; returns the previous one (None off the main thread)."""
+    if handler is None:
+        return None
+    try:
+        return signal.signal(signal.SIGTERM, handler)
+    except ValueError:  # signal handlers can only be set from the main thread
+        return None
 
 
 COMMANDS = {"snap": _cmd_snap, "patches": _cmd_patches, "surface": _cmd_surface,
@@ -352,12 +406,17 @@ def main(argv=None) -> int:
     """Entry point of the ``curvenet`` command; returns the exit code."""
     parser = build_parser()
     args = parser.parse_args(argv)
+    previous = _on_sigterm(_terminate)
     try:
         return COMMANDS[args.command](args)
     except CurvenetError as err:
         if args.debug:
             raise
-        print(f"curvenet {args.command}: error: {err}", file=sys.stderr)
+        inputs = getattr(args, "inputs", None) or [getattr(args, "input", None)
+                                                   or getattr(args, "mesh", None)]
+        named = len(inputs) == 1 and inputs[0] and not isinstance(err, OutputError)
+        msg = _naming(err, inputs[0]) if named else str(err)
+        print(f"curvenet {args.command}: error: {msg}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print(f"curvenet {args.command}: interrupted", file=sys.stderr)
@@ -368,6 +427,8 @@ def main(argv=None) -> int:
         print(f"curvenet {args.command}: internal error: {type(err).__name__}: {err} "
               f"(run with --debug for the traceback)", file=sys.stderr)
         return 1
+    finally:
+        _on_sigterm(previous)
 
 
 if __name__ == "__main__":
