@@ -60,21 +60,33 @@ def test_same_stem_inputs_are_refused_before_any_work(tmp_path, capsys):
         plan_outputs([str(a), str(a)], out, "obj")
 
 
-def test_an_internal_error_in_one_file_does_not_stop_the_batch(tmp_path, capsys):
+def test_an_internal_error_in_one_file_does_not_stop_the_batch(tmp_path, capsys, monkeypatch):
+    import curvenet.pipeline
     deep = tmp_path / "deep.json"
-    deep.write_text("[" * 100_000)  # RecursionError inside the JSON parser
+    deep.write_text("[" * 100_000)  # bad input: one error row, not an internal failure
     box, house = _shapes(tmp_path / "in")[:2]
+    broken = tmp_path / "broken.obj"
+    broken.write_bytes(box.read_bytes())
+    real = curvenet.pipeline.surface
+
+    def surface(source, **kw):  # an internal bug that shows for one file only
+        if str(source).endswith("broken.obj"):
+            raise RecursionError("maximum recursion depth exceeded")
+        return real(source, **kw)
+    monkeypatch.setattr(curvenet.pipeline, "surface", surface)
     report = tmp_path / "r.json"
-    code = main(["surface", str(deep), str(box), str(house), "--out-dir", str(tmp_path / "o"),
-                 "--method", "classical", "--report", str(report)])
+    code = main(["surface", str(deep), str(broken), str(box), str(house), "--out-dir",
+                 str(tmp_path / "o"), "--method", "classical", "--report", str(report)])
     out = capsys.readouterr().out
     assert code == 1  # documented: an internal failure in any file -> 1, after the batch
     assert (tmp_path / "o" / "box.obj").is_file() and (tmp_path / "o" / "house.obj").is_file()
     rows = {os.path.basename(r["input"]): r for r in json.loads(report.read_text())["rows"]}
-    assert rows["deep.json"]["status"] == "internal"
-    assert "RecursionError" in rows["deep.json"]["error"]
+    assert rows["deep.json"]["status"] == "error"
+    assert "nested too deeply" in rows["deep.json"]["error"]
+    assert rows["broken.obj"]["status"] == "internal"
+    assert "RecursionError" in rows["broken.obj"]["error"]
     assert rows["box.obj"]["status"] == rows["house.obj"]["status"] == "ok"
-    assert "2 of 3 surfaced" in out and "1 internal failures" in out
+    assert "2 of 4 surfaced" in out and "1 internal failures" in out
 
 
 # --------------------------------------------------------------------------- report
