@@ -8,6 +8,7 @@ backend switch); matplotlib is imported inside :func:`render_preview`, so
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -318,19 +319,52 @@ def render_preview(path, *, strokes=None, network=None, patches=None, mesh=None,
     >>> out.suffix
     '.png'
     """
+    width, height = _size(size)
+    views = _views(view)
+    rot = _rotation(up)
+    lines, line_colours = _strokes_with_colours(strokes)
+    edge_sets, network = _patch_list(patches, network)
+    hl_index, hl_extra, hl_edges = _highlights(highlight, edge_sets, network)
+    fans = _patch_fans(network, edge_sets, hl_index, hl_extra)
+    mesh_v, mesh_f = _preview_mesh(mesh)
+    scene = _Scene.build(rot, lines, line_colours, network, hl_edges, fans, mesh_v, mesh_f)
+    fig = _figure(scene, views, width, height, title)
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=100, facecolor="white")
+    return path
+
+
+def _size(size) -> tuple[int, int]:
+    """``(width, height)`` in pixels, each 16..10000."""
     try:
         width, height = (int(s) for s in size)
     except (TypeError, ValueError):
         raise InvalidParameterError(f"size must be (width, height), got {size!r}") from None
     if not (16 <= width <= 10_000 and 16 <= height <= 10_000):
         raise InvalidParameterError(f"size must be 16..10000 pixels each, got {size!r}")
-    views = _views(view)
+    return width, height
+
+
+def _rotation(up) -> np.ndarray:
+    """``(3, 3) float64`` taking data coordinates (row vectors) to picture coordinates."""
     if up not in _UP:
         raise InvalidParameterError(f"up must be one of {sorted(_UP)}, got {up!r}")
-    lines, line_colours = _strokes_with_colours(strokes)
-    edge_sets, network = _patch_list(patches, network)
+    return np.asarray(_UP[up], dtype=np.float64).T
 
-    # highlight: patch indices recolour their patch; edge-id cycles are added as polygons
+
+def _highlights(highlight, edge_sets, network):
+    """Split ``highlight`` into patch indices and extra cycles; collect their curves.
+
+    Returns
+    -------
+    hl_index : set of int
+        Patches recoloured in :data:`HIGHLIGHT_COLOUR`.
+    hl_extra : list of tuple of int
+        Edge-id cycles not in the patch list, drawn as extra polygons.
+    hl_edges : list of (n, 3) float64
+        Curves of every highlighted cycle, drawn emphasised.
+    """
     hl_index, hl_extra, hl_edges = set(), [], []
     for item in highlight or []:
         if isinstance(item, (int, np.integer)):
@@ -345,93 +379,137 @@ def render_preview(path, *, strokes=None, network=None, patches=None, mesh=None,
                 raise InvalidParameterError("highlight: edge ids need network= or patches=")
             hl_extra.append(edges)
         hl_edges += [network.edges[e].curve for e in _edge_ids(network, edges)]
+    return hl_index, hl_extra, hl_edges
 
-    # patch polygons as fan triangles, one colour each, all in one depth-sorted collection
+
+def _patch_fans(network, edge_sets, hl_index, hl_extra):
+    """Fan triangles of the patch polygons, one palette colour per patch.
+
+    Highlighted patches (indices ``hl_index``) and the extra cycles ``hl_extra``
+    take :data:`HIGHLIGHT_COLOUR` and :data:`HIGHLIGHT_AMBIENT`.
+
+    Returns
+    -------
+    tris : list of (t, 3, 3) float64
+    rgb : list of (t, 3) float64
+    ambient : list of (t,) float64
+        One entry per polygon.
+    """
     fill = [(edges, HIGHLIGHT_COLOUR if i in hl_index else colour)
             for i, (edges, colour) in enumerate(zip(edge_sets, _palette(len(edge_sets))))]
     fill += [(edges, HIGHLIGHT_COLOUR) for edges in hl_extra]
-    patch_tris, patch_rgb, patch_amb = [], [], []
+    tris, rgb, amb = [], [], []
     for edges, colour in fill:
         for poly in patch_polygons(network, edges):
             t = _fan(poly, rings=FAN_RINGS)
-            patch_tris.append(t)
-            patch_rgb.append(np.broadcast_to(colour, (len(t), 3)))
-            amb = HIGHLIGHT_AMBIENT if colour is HIGHLIGHT_COLOUR else AMBIENT
-            patch_amb.append(np.full(len(t), amb))
+            tris.append(t)
+            rgb.append(np.broadcast_to(colour, (len(t), 3)))
+            a = HIGHLIGHT_AMBIENT if colour is HIGHLIGHT_COLOUR else AMBIENT
+            amb.append(np.full(len(t), a))
+    return tris, rgb, amb
 
-    mesh_v = mesh_f = None
-    if mesh is not None:
-        from .evaluate import load_mesh_arrays
 
-        mesh_v, mesh_f = load_mesh_arrays(mesh, name="mesh")
-        mesh_v, mesh_f = decimate_clustering(mesh_v, mesh_f, MAX_PREVIEW_FACES)
+def _preview_mesh(mesh):
+    """``(vertices, faces)`` of ``mesh`` decimated to :data:`MAX_PREVIEW_FACES`, or Nones."""
+    if mesh is None:
+        return None, None
+    from .evaluate import load_mesh_arrays
 
-    net_curves = [] if network is None else [e.curve for e in network.edges]
-    net_colours = [] if network is None else [
-        _EDGE_COLOURS.get(e.label, _EDGE_COLOURS["boundary"]) for e in network.edges]
-    net_pos = (np.zeros((0, 3)) if network is None or not net_curves
-               else network.positions)
-    # rotate everything so that the data's up axis is the picture's z
-    rot = np.asarray(_UP[up], dtype=np.float64).T
-    lines = [x @ rot for x in lines]
-    hl_edges = [x @ rot for x in hl_edges]
-    net_curves = [x @ rot for x in net_curves]
-    net_pos = net_pos @ rot
-    patch_tris = [t @ rot for t in patch_tris]
-    if mesh_v is not None:
-        mesh_v = mesh_v @ rot
+    mesh_v, mesh_f = load_mesh_arrays(mesh, name="mesh")
+    return decimate_clustering(mesh_v, mesh_f, MAX_PREVIEW_FACES)
 
-    pts = [np.zeros((0, 3)), net_pos] + lines + hl_edges + net_curves
-    if mesh_v is not None:
-        pts.append(mesh_v[np.unique(mesh_f)])
-    pts = np.concatenate(pts)
-    if len(pts) == 0:
-        raise InvalidParameterError(
-            "render_preview: nothing to draw (give strokes, network, patches or mesh)")
-    lo, hi = pts.min(axis=0), pts.max(axis=0)
 
+@dataclass
+class _Scene:
+    """Everything a preview draws, rotated so that the data's up axis is z."""
+
+    lines: list                 # strokes, (n, 3) each
+    line_colours: list
+    net_curves: list            # network curves, (n, 3) each
+    net_colours: list
+    net_pos: np.ndarray         # (V, 3) junctions
+    hl_edges: list              # highlighted curves, (n, 3) each
+    patch_tris: np.ndarray | None   # (T, 3, 3)
+    patch_rgb: np.ndarray | None    # (T, 3)
+    patch_amb: np.ndarray | None    # (T,)
+    mesh_tris: np.ndarray | None    # (F, 3, 3)
+    lo: np.ndarray              # (3,) bounding box of all of it
+    hi: np.ndarray
+
+    @classmethod
+    def build(cls, rot, lines, line_colours, network, hl_edges, fans, mesh_v, mesh_f):
+        """Rotate by ``rot`` (3, 3) and bound; raises when there is nothing to draw."""
+        net_curves = [] if network is None else [e.curve for e in network.edges]
+        net_colours = [] if network is None else [
+            _EDGE_COLOURS.get(e.label, _EDGE_COLOURS["boundary"]) for e in network.edges]
+        net_pos = (np.zeros((0, 3)) if network is None or not net_curves
+                   else network.positions)
+        lines = [x @ rot for x in lines]
+        hl_edges = [x @ rot for x in hl_edges]
+        net_curves = [x @ rot for x in net_curves]
+        net_pos = net_pos @ rot
+        tris, rgb, amb = fans
+        tris = [t @ rot for t in tris]
+        if mesh_v is not None:
+            mesh_v = mesh_v @ rot
+        pts = [np.zeros((0, 3)), net_pos] + lines + hl_edges + net_curves
+        if mesh_v is not None:
+            pts.append(mesh_v[np.unique(mesh_f)])
+        pts = np.concatenate(pts)
+        if len(pts) == 0:
+            raise InvalidParameterError(
+                "render_preview: nothing to draw (give strokes, network, patches or mesh)")
+        return cls(lines, line_colours, net_curves, net_colours, net_pos, hl_edges,
+                   np.concatenate(tris) if tris else None,
+                   np.concatenate(rgb) if rgb else None,
+                   np.concatenate(amb) if amb else None,
+                   None if mesh_v is None else mesh_v[mesh_f],
+                   pts.min(axis=0), pts.max(axis=0))
+
+
+def _figure(scene: _Scene, views, width: int, height: int, title):
+    """A matplotlib Figure (Agg canvas) with one 3D panel per ``(elev, azim)`` view."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
-    from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
 
     fig = Figure(figsize=(width / 100.0, height / 100.0), dpi=100)
     FigureCanvasAgg(fig)
     fig.patch.set_facecolor("white")
-    mesh_tris = None if mesh_v is None else mesh_v[mesh_f]  # (F, 3, 3)
-    all_patch = np.concatenate(patch_tris) if patch_tris else None
-    all_patch_rgb = np.concatenate(patch_rgb) if patch_rgb else None
-    all_patch_amb = np.concatenate(patch_amb) if patch_amb else None
     for i, (elev, azim) in enumerate(views):
         ax = fig.add_subplot(1, len(views), i + 1, projection="3d")
         ax.computed_zorder = False  # our zorder: surfaces, then curves on top
-        light = _light(elev, azim)
-        if mesh_tris is not None:
-            ax.add_collection3d(Poly3DCollection(
-                mesh_tris, facecolors=_shade(mesh_tris, _MESH_COLOUR, light),
-                edgecolors="none", linewidths=0, antialiased=False, zorder=1))
-        if all_patch is not None:
-            ax.add_collection3d(Poly3DCollection(
-                all_patch, facecolors=_shade(all_patch, all_patch_rgb, light, all_patch_amb),
-                edgecolors="none", linewidths=0, antialiased=False, zorder=2))
-        if lines:
-            ax.add_collection3d(Line3DCollection(lines, colors=line_colours, linewidths=0.6,
-                                                 alpha=0.8, zorder=4))
-        if net_curves:
-            ax.add_collection3d(Line3DCollection(net_curves, colors=net_colours,
-                                                 linewidths=1.2, zorder=5))
-            ax.scatter(net_pos[:, 0], net_pos[:, 1], net_pos[:, 2], s=4, c="k",
-                       depthshade=False, zorder=6)
-        if hl_edges:
-            ax.add_collection3d(Line3DCollection(hl_edges, colors=[HIGHLIGHT_COLOUR],
-                                                 linewidths=3.0, zorder=7))
-        _frame(ax, lo, hi, elev, azim)
+        _draw_panel(ax, scene, _light(elev, azim))
+        _frame(ax, scene.lo, scene.hi, elev, azim)
     if title:
         fig.suptitle(str(title), fontsize=11)
     fig.subplots_adjust(left=0, right=1, bottom=0, top=0.94 if title else 1, wspace=0)
-    path = Path(path)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=100, facecolor="white")
-    return path
+    return fig
+
+
+def _draw_panel(ax, scene: _Scene, light):
+    """Shaded mesh and patches, then strokes, curves, junctions and highlights on top."""
+    from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection
+
+    if scene.mesh_tris is not None:
+        ax.add_collection3d(Poly3DCollection(
+            scene.mesh_tris, facecolors=_shade(scene.mesh_tris, _MESH_COLOUR, light),
+            edgecolors="none", linewidths=0, antialiased=False, zorder=1))
+    if scene.patch_tris is not None:
+        ax.add_collection3d(Poly3DCollection(
+            scene.patch_tris,
+            facecolors=_shade(scene.patch_tris, scene.patch_rgb, light, scene.patch_amb),
+            edgecolors="none", linewidths=0, antialiased=False, zorder=2))
+    if scene.lines:
+        ax.add_collection3d(Line3DCollection(scene.lines, colors=scene.line_colours,
+                                             linewidths=0.6, alpha=0.8, zorder=4))
+    if scene.net_curves:
+        ax.add_collection3d(Line3DCollection(scene.net_curves, colors=scene.net_colours,
+                                             linewidths=1.2, zorder=5))
+        pos = scene.net_pos
+        ax.scatter(pos[:, 0], pos[:, 1], pos[:, 2], s=4, c="k", depthshade=False, zorder=6)
+    if scene.hl_edges:
+        ax.add_collection3d(Line3DCollection(scene.hl_edges, colors=[HIGHLIGHT_COLOUR],
+                                             linewidths=3.0, zorder=7))
 
 
 def _frame(ax, lo, hi, elev, azim):
