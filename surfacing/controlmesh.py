@@ -335,18 +335,54 @@ def build_control_mesh(curves, loops, resolution: int = 4, *,
     if orient:
         loops = orient_loops(loops, len(curves))
     jend, jpos = _junctions(curves, loops, diag)
-    n_j = len(jpos)
-
-    # shared curve samples
     closed = jend[:, 0] == jend[:, 1]
     if adaptive:
         k_c = N * _equalise_strips(curve_pieces(curves, closed), loops)
     else:
         k_c = N * np.where(closed, 2, 1)
+    curve_pos, curve_vids, samples = _sample_curves(curves, jend, jpos, k_c)
+    nid = n_curve_v = len(curve_pos)
+    positions, quads_all, fpatch, kinds = [curve_pos], [], [], []
+    for j, lp in enumerate(loops):
+        B, BP, starts, dense = _loop_boundary(lp, curves, curve_vids, samples)
+        kind, p, q, roll, sides = _patch_layout(lp, dense, starts, k_c, N, len(B),
+                                                straight_angle)
+        kinds.append(kind)
+        if kind in ("grid", "pieces4", "halves"):
+            newpos, quads, nid = _grid_patch(np.roll(B, -roll), np.roll(BP, -roll, axis=0),
+                                             p, q, nid)
+        else:
+            corners = [starts[s[0]] for s in sides] if kind == "split-coons4" else None
+            newpos, quads, nid = _split_patch(B, BP, N, nid, corners)
+        positions.append(newpos)
+        quads_all.append(quads)
+        fpatch.append(np.full(len(quads), j))
+
+    V = np.concatenate(positions)
+    on_curve = np.zeros(len(V), bool)
+    on_curve[:n_curve_v] = True
+    target = V.copy()
+    return ControlMesh(V, np.concatenate(quads_all).astype(np.int64),
+                       np.concatenate(fpatch).astype(np.int64), curve_vids, on_curve, target,
+                       jend, len(jpos), loops, kinds, diag)
+
+
+def _sample_curves(curves, jend, jpos, k_c):
+    """Shared control vertices along the curves: junctions first, then each curve's inside.
+
+    Returns
+    -------
+    positions : (n, 3) float64
+        Junction positions ``jpos``, then the inner samples of each curve in order.
+    curve_vids : list of (k_c + 1,) int64
+        Vertex ids along each curve, junction to junction.
+    samples : list of (k_c + 1, 3) float64
+        Each curve resampled to ``k_c`` equal-arc segments, ends on its junctions.
+    """
     pos_blocks = [jpos]
     curve_vids = []
     samples = []
-    nid = n_j
+    nid = len(jpos)
     for i, c in enumerate(curves):
         s = resample(c, int(k_c[i]))
         s[0], s[-1] = jpos[jend[i, 0]], jpos[jend[i, 1]]
@@ -355,109 +391,129 @@ def build_control_mesh(curves, loops, resolution: int = 4, *,
         pos_blocks.append(s[1:-1])
         curve_vids.append(ids.astype(np.int64))
         samples.append(s)
-    n_curve_v = nid
-    positions = [np.concatenate(pos_blocks)]
-    quads_all, fpatch, kinds = [], [], []
+    return np.concatenate(pos_blocks), curve_vids, samples
 
-    for j, lp in enumerate(loops):
-        bids, bpos, starts, dense = [], [], [], []
-        off = 0
-        for ci, fwd in lp:
-            ids = curve_vids[ci] if fwd else curve_vids[ci][::-1]
-            ps = samples[ci] if fwd else samples[ci][::-1]
-            starts.append(off)
-            bids.append(ids[:-1])
-            bpos.append(ps[:-1])
-            dense.append(curves[ci] if fwd else curves[ci][::-1])
-            off += len(ids) - 1
-        B = np.concatenate(bids)
-        BP = np.concatenate(bpos)
-        Lb = len(B)
-        T = Lb // N
-        sides = group_sides(dense, straight_angle) if len(lp) >= 2 else []
-        side_len = [sum(int(k_c[lp[i][0]]) for i in s) for s in sides]
-        roll = 0
-        if len(sides) == 4 and side_len[0] == side_len[2] and side_len[1] == side_len[3]:
-            kind, p, q = "grid", side_len[0], side_len[1]
-            roll = starts[sides[0][0]]
-        elif T == 4:
-            kind, p, q = "pieces4", N, N
-        elif T <= 2:
-            kind, p, q = "halves", Lb // 4, Lb // 4
-        else:
-            kind = "split-coons4" if len(sides) == 4 else "split"
-        kinds.append(kind)
-        if kind in ("grid", "pieces4", "halves"):
-            Br = np.roll(B, -roll)
-            BPr = np.roll(BP, -roll, axis=0)
-            G, nid = _grid_ids(Br, p, q, nid)
-            idx = np.arange(Lb)
-            bottom = BPr[idx[:p + 1]]
-            right = BPr[idx[p:p + q + 1]]
-            top = BPr[(p + q + (p - np.arange(p + 1))) % Lb]
-            left = BPr[(2 * p + q + (q - np.arange(q + 1))) % Lb]
-            grid = coons_grid(bottom, right, top, left)
-            if p > 1 and q > 1:
-                positions.append(grid[1:p, 1:q].reshape(-1, 3))
-            quads_all.append(_grid_quads(G))
-            fpatch.append(np.full(p * q, j))
-            continue
-        # centre split into T sub-quads of h x h
-        h = N // 2
-        centre = nid
-        nid += 1
-        spokes = []
-        for i in range(T):
-            spokes.append(np.concatenate([[centre], nid + np.arange(h - 1),
-                                          [B[(i * N + h) % Lb]]]).astype(np.int64))
-            nid += h - 1
-        subs = []
-        for i in range(T):
-            G = np.full((h + 1, h + 1), -1, dtype=np.int64)
-            G[:, 0] = spokes[i]
-            G[:, h] = B[((i + 1) * N + h - np.arange(h + 1)) % Lb]
-            G[h, :] = B[(i * N + h + np.arange(h + 1)) % Lb]
-            G[0, :] = spokes[(i + 1) % T]
-            if h > 1:
-                G[1:h, 1:h] = (nid + np.arange((h - 1) ** 2)).reshape(h - 1, h - 1)
-                nid += (h - 1) ** 2
-            subs.append(G)
-        new_lo = centre
-        n_new = nid - new_lo
-        newpos = np.zeros((n_new, 3))
-        if kind == "split-coons4":
-            # local mesh -> Tutte embedding in the unit square -> 4-sided Coons patch
-            ids_all, ql = _local_quads(subs, B, new_lo, n_new)
-            corners = [starts[s[0]] for s in sides]
-            uvb = np.zeros((Lb, 2))
-            side_pts = []
-            for s in range(4):
-                a0, a1 = corners[s], corners[(s + 1) % 4]
-                n_s = (a1 - a0) % Lb
-                t = np.arange(n_s) / n_s
-                sel = (a0 + np.arange(n_s)) % Lb
-                uvb[sel] = [np.stack([t, 0 * t], 1), np.stack([1 + 0 * t, t], 1),
-                            np.stack([1 - t, 1 + 0 * t], 1), np.stack([0 * t, 1 - t], 1)][s]
-                side_pts.append(BP[(a0 + np.arange(n_s + 1)) % Lb])
-            uv = _tutte_square(ql, len(ids_all), np.arange(Lb), uvb)
-            newpos = coons_eval(side_pts[0], side_pts[1], side_pts[2][::-1], side_pts[3][::-1],
-                                uv[Lb:])
-        else:
-            # harmonic (uniform-weight) interior: the 3D image of a Tutte embedding into
-            # a convex polygon, so it cannot fold the way straight spokes do in a
-            # concave loop (the L of an L-prism)
-            ids_all, ql = _local_quads(subs, B, new_lo, n_new)
-            xyz = _tutte_square(ql, len(ids_all), np.arange(Lb), BP)
-            newpos = xyz[Lb:]
-        positions.append(newpos)
-        q_loc = np.concatenate([_grid_quads(G) for G in subs])
-        quads_all.append(q_loc)
-        fpatch.append(np.full(len(q_loc), j))
 
-    V = np.concatenate(positions)
-    on_curve = np.zeros(len(V), bool)
-    on_curve[:n_curve_v] = True
-    target = V.copy()
-    return ControlMesh(V, np.concatenate(quads_all).astype(np.int64),
-                       np.concatenate(fpatch).astype(np.int64), curve_vids, on_curve, target,
-                       jend, n_j, loops, kinds, diag)
+def _loop_boundary(lp, curves, curve_vids, samples):
+    """A loop's border in traversal order.
+
+    Returns
+    -------
+    B : (Lb,) int64
+        Control vertex ids around the loop (each shared end once).
+    BP : (Lb, 3) float64
+        Their positions.
+    starts : list of int
+        Index in ``B`` where each of the loop's curves starts.
+    dense : list of (m_i, 3) float64
+        The loop's curves, oriented along the loop.
+    """
+    bids, bpos, starts, dense = [], [], [], []
+    off = 0
+    for ci, fwd in lp:
+        ids = curve_vids[ci] if fwd else curve_vids[ci][::-1]
+        ps = samples[ci] if fwd else samples[ci][::-1]
+        starts.append(off)
+        bids.append(ids[:-1])
+        bpos.append(ps[:-1])
+        dense.append(curves[ci] if fwd else curves[ci][::-1])
+        off += len(ids) - 1
+    return np.concatenate(bids), np.concatenate(bpos), starts, dense
+
+
+def _patch_layout(lp, dense, starts, k_c, N, Lb, straight_angle):
+    """How a loop is meshed: ``(kind, p, q, roll, sides)``.
+
+    A grid of ``p x q`` quads when the loop has four sides with opposite sides of
+    equal sample counts (``"grid"``, border rolled by ``roll`` to start at a
+    corner), four pieces (``"pieces4"``) or at most two (``"halves"``); otherwise
+    a centre split (``"split-coons4"`` for four sides, else ``"split"``; ``p``,
+    ``q`` unused). ``sides`` are the groups of loop positions per side.
+    """
+    T = Lb // N
+    sides = group_sides(dense, straight_angle) if len(lp) >= 2 else []
+    side_len = [sum(int(k_c[lp[i][0]]) for i in s) for s in sides]
+    if len(sides) == 4 and side_len[0] == side_len[2] and side_len[1] == side_len[3]:
+        return "grid", side_len[0], side_len[1], starts[sides[0][0]], sides
+    if T == 4:
+        return "pieces4", N, N, 0, sides
+    if T <= 2:
+        return "halves", Lb // 4, Lb // 4, 0, sides
+    return ("split-coons4" if len(sides) == 4 else "split"), 0, 0, 0, sides
+
+
+def _grid_patch(Br, BPr, p, q, nid):
+    """Coons grid of ``p x q`` quads inside the border ``Br`` (ids) / ``BPr`` (positions).
+
+    Returns the new interior positions ``((p-1)(q-1), 3)``, the quads ``(p q, 4)``
+    and the next free vertex id.
+    """
+    Lb = len(Br)
+    G, nid = _grid_ids(Br, p, q, nid)
+    idx = np.arange(Lb)
+    bottom = BPr[idx[:p + 1]]
+    right = BPr[idx[p:p + q + 1]]
+    top = BPr[(p + q + (p - np.arange(p + 1))) % Lb]
+    left = BPr[(2 * p + q + (q - np.arange(q + 1))) % Lb]
+    grid = coons_grid(bottom, right, top, left)
+    newpos = grid[1:p, 1:q].reshape(-1, 3) if p > 1 and q > 1 else np.zeros((0, 3))
+    return newpos, _grid_quads(G), nid
+
+
+def _split_patch(B, BP, N, nid, corners):
+    """Centre split of a loop into ``T = len(B) / N`` sub-quads of ``h x h``, ``h = N / 2``.
+
+    Interior positions: with four side ``corners`` (indices into ``B``), a Tutte
+    embedding in the unit square mapped by the 4-sided Coons patch; without, the
+    harmonic (uniform-weight) interior: the 3D image of a Tutte embedding into a
+    convex polygon, so it cannot fold the way straight spokes do in a concave
+    loop (the L of an L-prism).
+
+    Returns the new positions, the quads and the next free vertex id.
+    """
+    Lb = len(B)
+    T = Lb // N
+    h = N // 2
+    centre = nid
+    nid += 1
+    spokes = []
+    for i in range(T):
+        spokes.append(np.concatenate([[centre], nid + np.arange(h - 1),
+                                      [B[(i * N + h) % Lb]]]).astype(np.int64))
+        nid += h - 1
+    subs = []
+    for i in range(T):
+        G = np.full((h + 1, h + 1), -1, dtype=np.int64)
+        G[:, 0] = spokes[i]
+        G[:, h] = B[((i + 1) * N + h - np.arange(h + 1)) % Lb]
+        G[h, :] = B[(i * N + h + np.arange(h + 1)) % Lb]
+        G[0, :] = spokes[(i + 1) % T]
+        if h > 1:
+            G[1:h, 1:h] = (nid + np.arange((h - 1) ** 2)).reshape(h - 1, h - 1)
+            nid += (h - 1) ** 2
+        subs.append(G)
+    ids_all, ql = _local_quads(subs, B, centre, nid - centre)
+    if corners is not None:
+        uvb, side_pts = _square_border(BP, corners)
+        uv = _tutte_square(ql, len(ids_all), np.arange(Lb), uvb)
+        newpos = coons_eval(side_pts[0], side_pts[1], side_pts[2][::-1], side_pts[3][::-1],
+                            uv[Lb:])
+    else:
+        newpos = _tutte_square(ql, len(ids_all), np.arange(Lb), BP)[Lb:]
+    return newpos, np.concatenate([_grid_quads(G) for G in subs]), nid
+
+
+def _square_border(BP, corners):
+    """Unit-square parameters ``(Lb, 2)`` of a four-sided border and its four side polylines."""
+    Lb = len(BP)
+    uvb = np.zeros((Lb, 2))
+    side_pts = []
+    for s in range(4):
+        a0, a1 = corners[s], corners[(s + 1) % 4]
+        n_s = (a1 - a0) % Lb
+        t = np.arange(n_s) / n_s
+        sel = (a0 + np.arange(n_s)) % Lb
+        uvb[sel] = [np.stack([t, 0 * t], 1), np.stack([1 + 0 * t, t], 1),
+                    np.stack([1 - t, 1 + 0 * t], 1), np.stack([0 * t, 1 - t], 1)][s]
+        side_pts.append(BP[(a0 + np.arange(n_s + 1)) % Lb])
+    return uvb, side_pts
