@@ -19,6 +19,18 @@ Public pieces:
   bisector), used by the tests;
 - :func:`crease_refine` -- the refinement stage of the pipeline.
 
+Deviations of the crease refit
+------------------------------
+* Convergence at CPU budgets: besides Eq. 9, near-surface samples are regressed
+  (``w_sdf``, L1) on the point-to-plane distance to their nearest kept input sample. Away
+  from creases that is the input's signed distance; near a crease, where the input samples
+  are dropped, it is the distance to the extrapolated planes of the two sides, i.e. the
+  sharp SDF whose kink on the bisector the strip lets the network represent.
+* Gap fill (speed): the strips are fixed, so the feature values and their gradients are
+  computed once for a sample pool; the network sees ``f0 + grad f0 . (x - x0)`` with
+  ``x0`` the detached sample, which has exactly f's value and first derivatives there (all
+  Eq. 9 needs), so training costs no more than a plain MLP. Extraction evaluates f exactly.
+
 References
 ----------
 Niu et al. 2025, "SharpNet", Appendix A (strips), Sec. 3.3 (splitting), Sec. 5.1 (Eq. 9).
@@ -28,12 +40,14 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import asdict, dataclass, fields, replace
+from dataclasses import asdict, dataclass
 
 import numpy as np
 from scipy.spatial import cKDTree
 
 from ._inputs import check_strokes
+from .presets import CREASE_PRESETS, CreaseConfig, crease_config
+from .training import Stage, Step, seeded, torch_device, train
 
 __all__ = [
     "CreaseConfig",
@@ -333,116 +347,6 @@ def crease_feature_set(strokes, vertices, faces, *, width: float, spacing: float
 # ---------------------------------------------------------------------------------------------
 # crease refinement
 # ---------------------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class CreaseConfig:
-    """Settings of :func:`crease_refine` (lengths in the unit frame: data in [-0.8, 0.8]^3).
-
-    Attributes
-    ----------
-    hidden, layers : int
-        SharpNet MLP size (paper Sec. 5: 4 x 256).
-    activation : {"softplus", "sine"}
-        Softplus(beta = 100) (Sec. 4) or SIREN sine (Sec. 5).
-    n_freqs : int
-        Positional-encoding octaves.
-    geometric_init : float or None
-        Radius of the initial sphere SDF (Softplus; see :class:`neural.sharpnet.SharpNet`).
-    steps, lr, batch : Adam steps, learning rate, surface points per step (the ambient
-        and near-surface batches have the same size).
-    res : int
-        Marching-cubes grid per axis over [-1, 1]^3.
-    strip_width : float
-        Half-width w of the crease strips (Appendix A).
-    strip_spacing : float
-        Strip element size along the stroke.
-    mollifier_radius : float
-        Support radius of each strip triangle's mollifier (Eq. 6).
-    feature_scale : float
-        Multiplier of the feature channels (network input scaling).
-    exclude : float
-        Surface samples of the input mesh closer than this to a crease stroke are dropped
-        (the input is rounded there); the strokes themselves constrain the crease.
-    guide_radius : float
-        Neighbourhood for the guide estimate from the input surface normals.
-    w_sur, w_ext, w_ekl, w_nor : float
-        Loss weights of Eq. 9 (``w_nor`` as in Eq. 10).
-    w_sdf : float
-        Weight of the value term on near-surface samples (not in the paper, see Notes).
-    ext_alpha : float
-        alpha of ``L_ext = exp(-alpha |Phi|)`` (not given in the paper; SIREN uses 100).
-    near_sigma : float
-        Std of the Gaussian offsets of the near-surface (Eikonal) samples.
-    pool : int
-        Surface samples drawn once from the input (their feature values are computed once).
-    stroke_weight : float
-        Share of the surface batch taken from stroke points.
-    use_features : bool
-        False fits the same network without feature channels (the no-crease baseline).
-    keep_tol : float
-        Output faces farther than this from the input surface and strokes are dropped
-        (removes stray level-set pieces; trims open surfaces to their input extent).
-    """
-
-    hidden: int = 128
-    layers: int = 3
-    activation: str = "softplus"
-    n_freqs: int = 2
-    geometric_init: float | None = 0.5
-    steps: int = 800
-    lr: float = 2e-3
-    batch: int = 3000
-    res: int = 128
-    strip_width: float = 0.08
-    strip_spacing: float = 0.025
-    mollifier_radius: float = 0.1
-    feature_scale: float = 10.0
-    exclude: float = 0.1
-    guide_radius: float = 0.12
-    w_sur: float = 7000.0
-    w_ext: float = 600.0
-    w_ekl: float = 50.0
-    w_nor: float = 15.0
-    w_sdf: float = 3000.0
-    ext_alpha: float = 100.0
-    near_sigma: float = 0.03
-    pool: int = 60000
-    stroke_weight: float = 0.2
-    use_features: bool = True
-    keep_tol: float = 0.1
-
-
-CREASE_PRESETS = {
-    "draft": CreaseConfig(),
-    "default": CreaseConfig(hidden=256, layers=4, steps=3000, res=192, pool=150000),
-    "paper": CreaseConfig(hidden=256, layers=4, steps=15000, res=256, pool=300000,
-                          batch=20000),
-}
-
-
-def crease_config(quality: str = "draft", overrides: dict | None = None) -> CreaseConfig:
-    """The preset ``quality`` with ``overrides`` (field name -> value) applied and checked.
-
-    Raises
-    ------
-    ValueError
-        Unknown preset or field, or a value out of range.
-    """
-    overrides = overrides or {}
-    if quality not in CREASE_PRESETS:
-        raise ValueError(f"quality must be one of {sorted(CREASE_PRESETS)}, got {quality!r}")
-    names = {f.name for f in fields(CreaseConfig)}
-    bad = sorted(set(overrides) - names)
-    if bad:
-        raise ValueError(f"unknown crease_refine setting(s) {bad}; known: {sorted(names)}")
-    cfg = replace(CREASE_PRESETS[quality], **overrides)
-    if cfg.activation not in ("softplus", "sine"):
-        raise ValueError(f"activation must be 'softplus' or 'sine', got {cfg.activation!r}")
-    for k in ("steps", "batch", "res", "pool", "hidden", "layers"):
-        if int(getattr(cfg, k)) < 1:
-            raise ValueError(f"{k} must be >= 1, got {getattr(cfg, k)!r}")
-    return cfg
-
-
 @dataclass
 class CreaseResult:
     """Output of :func:`crease_refine`.
@@ -534,66 +438,108 @@ def crease_refine(vertices, faces, strokes, labels=None, *, quality: str = "draf
     input is rounded there; the strokes pin the crease. With no crease stroke the fit runs
     without features (a plain SDF refit).
 
-    Deviation (convergence at CPU budgets): besides Eq. 9, near-surface samples are regressed
-    (``w_sdf``, L1) on the point-to-plane distance to their nearest kept input sample. Away
-    from creases that is the input's signed distance; near a crease, where the input samples
-    are dropped, it is the distance to the extrapolated planes of the two sides, i.e. the
-    sharp SDF whose kink on the bisector the strip lets the network represent.
-
-    Gap fill (speed): the strips are fixed, so the feature values and their gradients are
-    computed once for a sample pool; the network sees ``f0 + grad f0 . (x - x0)`` with ``x0``
-    the detached sample, which has exactly f's value and first derivatives there (all Eq. 9
-    needs), so training costs no more than a plain MLP. Extraction evaluates f exactly.
-    Ctrl-C during training stops it and extracts the current network
-    (``report["interrupted"]``).
+    Ctrl-C during training stops it (:func:`neural.training.train`) and extracts the
+    current network (``report["interrupted"]``). The deviations from the paper are listed
+    in the module notes.
 
     Examples
     --------
-    >>> import trimesh                                                   # doctest: +SKIP
-    >>> box = trimesh.creation.box()                                     # doctest: +SKIP
-    >>> res = crease_refine(box.vertices, box.faces, edges, ["crease"] * 12,
+    >>> import trimesh
+    >>> box = trimesh.creation.box().subdivide().subdivide()
+    >>> c = box.vertices[:8]                         # the corners of the unsubdivided box
+    >>> edges = [np.linspace(c[a], c[b], 20) for a in range(8) for b in range(a + 1, 8)
+    ...          if np.count_nonzero(c[a] != c[b]) == 1]
+    >>> res = crease_refine(box.vertices, box.faces, edges, ["crease"] * len(edges),
     ...                     progress=False)                              # doctest: +SKIP
     """
     import torch
 
-    from .feature import mollified_feature_function
-    from .sharpnet import FeatureSet, SharpNet, positional_encoding
+    from .sharpnet import SharpNet
 
     cfg = crease_config(quality, overrides)
     v, f, st, lab = _check_inputs(vertices, faces, strokes, labels)
-    try:
-        dev = torch.device(device)
-    except (RuntimeError, TypeError) as exc:
-        raise ValueError(f"device must be 'cpu' or 'cuda', got {device!r}") from exc
-    if dev.type not in ("cpu", "cuda") or (dev.type == "cuda" and not torch.cuda.is_available()):
-        raise ValueError(f"device {device!r} is not available (use 'cpu' or 'cuda')")
+    dev = torch_device(device)
     t_start = time.perf_counter()
-    rng = np.random.default_rng(seed)
-    gen = torch.Generator().manual_seed(seed)
-    torch.manual_seed(seed)
+    gen, rng = seeded(seed)
     dtype = torch.float32
 
-    # unit frame
-    used = [s for s, lb in zip(st, lab) if lb != "construction"]
-    allp = np.concatenate([v] + used) if used else v
-    lo, hi = allp.min(0), allp.max(0)
-    centre = 0.5 * (lo + hi)
-    scale = max(float((hi - lo).max()) / 1.6, 1e-12)
+    centre, scale = _unit_frame(v, st, lab)
     vu = (v - centre) / scale
     creases = [(s - centre) / scale for s, lb in zip(st, lab) if lb == "crease"]
     others = [(s - centre) / scale for s, lb in zip(st, lab) if lb == "boundary"]
+    feats = _crease_features(cfg, creases, vu, f)
+    pools, spts = _sample_pools(cfg, vu, f, creases, others, feats, rng, dev, dtype)
+    t_setup = time.perf_counter() - t_start
 
-    feats = None
-    n_strip = 0
-    if cfg.use_features and creases:
-        mv, mt, mc = crease_feature_set(creases, vu, f, width=cfg.strip_width,
-                                        spacing=cfg.strip_spacing,
-                                        guide_radius=cfg.guide_radius)
-        feats = FeatureSet(mv, mt, channels=mc, radius=cfg.mollifier_radius,
-                           scale=cfg.feature_scale, dtype=torch.float64)
-        n_strip = len(mt)
+    net = SharpNet(3, feats, hidden=cfg.hidden, layers=cfg.layers, n_freqs=cfg.n_freqs,
+                   activation=cfg.activation,
+                   geometric_init=cfg.geometric_init)
+    # the pools carry the feature values; the feature set stays on the host in float64 and
+    # is only used again for extraction (moving it with the network would cast it to float32)
+    net.features = None
+    net = net.to(dev, dtype)
 
-    # sample pool
+    t0 = time.perf_counter()
+    run = train(net.parameters(), [Stage("refit", cfg.steps, _refit_step(net, cfg, pools, gen))],
+                lr=cfg.lr, schedule="cosine", lr_min=0.05 * cfg.lr, progress=progress,
+                desc="crease refine")
+    t_train = time.perf_counter() - t0
+
+    t1 = time.perf_counter()
+    mv_, mf_ = _extract_sdf(net, feats, cfg, dev, dtype)
+    mv_, mf_ = _trim_to_input(mv_, mf_, vu, f, spts, rng, cfg.keep_tol)
+    t_extract = time.perf_counter() - t1
+    report = {
+        "timings": {"setup": t_setup, "train": t_train, "extract": t_extract,
+                    "total": time.perf_counter() - t_start},
+        "n_strip_triangles": int(len(feats.elements)) if feats is not None else 0,
+        "n_channels": int(feats.n_channels) if feats is not None else 0,
+        "n_crease_strokes": len(creases),
+        "final_loss": run.log.get("loss", float("nan")),
+        "interrupted": run.interrupted,
+        "quality": quality,
+        "seed": int(seed),
+        "device": str(dev),
+        "config": asdict(cfg),
+        "frame": {"centre": centre.tolist(), "scale": scale},
+    }
+    return CreaseResult(mv_ * scale + centre, mf_, report)
+
+
+def _unit_frame(v, strokes, labels):
+    """``(centre (3,), scale)`` mapping the mesh and the used strokes into [-0.8, 0.8]^3."""
+    used = [s for s, lb in zip(strokes, labels) if lb != "construction"]
+    allp = np.concatenate([v] + used) if used else v
+    lo, hi = allp.min(0), allp.max(0)
+    return 0.5 * (lo + hi), max(float((hi - lo).max()) / 1.6, 1e-12)
+
+
+def _crease_features(cfg: CreaseConfig, creases, vu, f):
+    """The SharpNet feature set of the crease strips (float64, host), or None."""
+    if not (cfg.use_features and creases):
+        return None
+    import torch
+
+    from .sharpnet import FeatureSet
+    mv, mt, mc = crease_feature_set(creases, vu, f, width=cfg.strip_width,
+                                    spacing=cfg.strip_spacing, guide_radius=cfg.guide_radius)
+    return FeatureSet(mv, mt, channels=mc, radius=cfg.mollifier_radius,
+                      scale=cfg.feature_scale, dtype=torch.float64)
+
+
+def _sample_pools(cfg: CreaseConfig, vu, f, creases, others, feats, rng, dev, dtype):
+    """Training samples drawn once, with their feature values and gradients.
+
+    Returns
+    -------
+    pools : dict
+        ``surface``, ``strokes`` (or None), ``near``, ``ambient``: ``(x, f0, grad f0)``
+        tensors (:func:`_with_features`); ``normals`` (P, 3) of the surface samples;
+        ``near_target`` (N,), the value target of the near-surface samples.
+    spts : (K, 3) float64
+        The stroke points (unit frame).
+    """
+    import torch
     sp, sn = _sample_mesh(vu, f, cfg.pool, rng)
     stroke_pts = [_resample(s, 0.25 * cfg.strip_spacing) for s in creases + others]
     if creases:
@@ -610,101 +556,101 @@ def crease_refine(vertices, faces, strokes, labels=None, *, quality: str = "draf
     _, jn = cKDTree(sp).query(near)
     near_target = torch.tensor(((near - sp[jn]) * sn[jn]).sum(1), dtype=dtype, device=dev)
     amb = rng.uniform(-1.0, 1.0, size=(cfg.pool, 3))
+    pools = {"surface": _with_features(feats, sp, dev, dtype),
+             "normals": torch.tensor(sn, dtype=dtype, device=dev),
+             "strokes": _with_features(feats, spts, dev, dtype) if len(spts) else None,
+             "near": _with_features(feats, near, dev, dtype),
+             "near_target": near_target,
+             "ambient": _with_features(feats, amb, dev, dtype)}
+    return pools, spts
 
-    def with_features(x):  # -> tensors (x, f0, grad f0) on dev
-        xt = torch.tensor(x, dtype=torch.float64)
-        if feats is None:
-            return xt.to(dev, dtype), None, None
-        fs, gs = [], []
-        for s in range(0, len(xt), 20000):
-            xc = xt[s:s + 20000].clone().requires_grad_(True)
-            fv = feats(xc)  # (B, C)
-            if fv.requires_grad:
-                g = torch.stack([torch.autograd.grad(fv[:, c].sum(), xc, retain_graph=True)[0]
-                                 for c in range(fv.shape[1])], 1)  # (B, C, 3)
-            else:  # no strip element near any point of this chunk: f = 0, grad f = 0
-                g = torch.zeros(fv.shape + (3,), dtype=fv.dtype)  # (B, C, 3)
-            fs.append(fv.detach())
-            gs.append(g.detach())
-        return (xt.to(dev, dtype), torch.cat(fs).to(dev, dtype), torch.cat(gs).to(dev, dtype))
 
-    pool_s = with_features(sp)
-    pool_n = torch.tensor(sn, dtype=dtype, device=dev)
-    pool_k = with_features(spts) if len(spts) else None
-    pool_near = with_features(near)
-    pool_a = with_features(amb)
-    t_setup = time.perf_counter() - t_start
+def _with_features(feats, x, dev, dtype, chunk: int = 20000):
+    """``(x, f0, grad f0)`` tensors on ``dev``: points, feature values (B, C), gradients (B, C, 3).
 
-    net = SharpNet(3, feats, hidden=cfg.hidden, layers=cfg.layers, n_freqs=cfg.n_freqs,
-                   activation=cfg.activation,
-                   geometric_init=cfg.geometric_init)
-    # the pools carry the feature values; the feature set stays on the host in float64 and
-    # is only used again for extraction (moving it with the network would cast it to float32)
-    net.features = None
-    net = net.to(dev, dtype)
+    Features are evaluated exactly in float64 on the host; ``f0, grad f0`` are None without
+    features.
+    """
+    import torch
+    xt = torch.tensor(x, dtype=torch.float64)
+    if feats is None:
+        return xt.to(dev, dtype), None, None
+    fs, gs = [], []
+    for s in range(0, len(xt), chunk):
+        xc = xt[s:s + chunk].clone().requires_grad_(True)
+        fv = feats(xc)  # (B, C)
+        if fv.requires_grad:
+            g = torch.stack([torch.autograd.grad(fv[:, c].sum(), xc, retain_graph=True)[0]
+                             for c in range(fv.shape[1])], 1)  # (B, C, 3)
+        else:  # no strip element near any point of this chunk: f = 0, grad f = 0
+            g = torch.zeros(fv.shape + (3,), dtype=fv.dtype)  # (B, C, 3)
+        fs.append(fv.detach())
+        gs.append(g.detach())
+    return (xt.to(dev, dtype), torch.cat(fs).to(dev, dtype), torch.cat(gs).to(dev, dtype))
 
-    def phi(pool, idx):
-        x, f0, g0 = pool
-        xb = x[idx].clone().requires_grad_(True)  # (B, 3)
-        inp = positional_encoding(xb, cfg.n_freqs)
-        if f0 is not None:
-            lin = f0[idx] + torch.einsum("bcd,bd->bc", g0[idx], xb - xb.detach())
-            inp = torch.cat([inp, lin], -1)
-        out = net.mlp(inp)[:, 0]
-        (grad,) = torch.autograd.grad(out.sum(), xb, create_graph=True)
-        return out, grad
 
-    opt = torch.optim.Adam(net.parameters(), lr=cfg.lr)
-    sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, cfg.steps, eta_min=0.05 * cfg.lr)
+def _phi(net, n_freqs, pool, idx):
+    """SDF values (B,) and gradients (B, 3) at ``pool[idx]`` (linearised features)."""
+    import torch
+
+    from .sharpnet import positional_encoding
+    x, f0, g0 = pool
+    xb = x[idx].clone().requires_grad_(True)  # (B, 3)
+    inp = positional_encoding(xb, n_freqs)
+    if f0 is not None:
+        lin = f0[idx] + torch.einsum("bcd,bd->bc", g0[idx], xb - xb.detach())
+        inp = torch.cat([inp, lin], -1)
+    out = net.mlp(inp)[:, 0]
+    (grad,) = torch.autograd.grad(out.sum(), xb, create_graph=True)
+    return out, grad
+
+
+def _refit_step(net, cfg: CreaseConfig, pools, gen):
+    """Step function of the refit: the losses of Eq. 9 plus the near-surface value term."""
+    import torch
+    dev = pools["near_target"].device
+    pool_s, pool_k, pool_near, pool_a = (pools[k] for k in ("surface", "strokes", "near",
+                                                             "ambient"))
     nb = cfg.batch
     nk = int(round(cfg.stroke_weight * nb)) if pool_k is not None else 0
     ns = nb - nk
-    loss_val = float("nan")
-    interrupted = False
-    it = range(cfg.steps)
-    bar = None
-    if progress:
-        from tqdm import tqdm
-        bar = it = tqdm(it, desc="crease refine", leave=False)
-    t0 = time.perf_counter()
-    try:
-        for _ in it:
-            i_s = torch.randint(0, len(pool_s[0]), (ns,), generator=gen).to(dev)
-            i_n = torch.randint(0, len(pool_near[0]), (nb,), generator=gen).to(dev)
-            i_a = torch.randint(0, len(pool_a[0]), (nb,), generator=gen).to(dev)
-            ps, gs_ = phi(pool_s, i_s)
-            pn, gn = phi(pool_near, i_n)
-            l_sdf = (pn - near_target[i_n]).abs().mean()
-            pa, ga = phi(pool_a, i_a)
-            l_sur = ps.abs().mean()
-            if nk:
-                i_k = torch.randint(0, len(pool_k[0]), (nk,), generator=gen).to(dev)
-                pk, gk = phi(pool_k, i_k)
-                l_sur = (ns * l_sur + nk * pk.abs().mean()) / nb
-                geik = torch.cat([gs_, gn, gk])
-            else:
-                geik = torch.cat([gs_, gn])
-            l_ext = torch.exp(-cfg.ext_alpha * pa.abs()).mean()
-            l_ekl = (1.0 - geik.norm(dim=-1)).abs().mean()
-            l_nor = (gs_ - pool_n[i_s]).norm(dim=-1).mean()
-            loss = (cfg.w_sur * l_sur + cfg.w_ext * l_ext + cfg.w_ekl * l_ekl
-                    + cfg.w_nor * l_nor + cfg.w_sdf * l_sdf)
-            opt.zero_grad()
-            loss.backward()
-            opt.step()
-            sched.step()
-            loss_val = float(loss.detach())
-            if bar is not None:
-                bar.set_postfix(loss=f"{loss_val:.3g}")
-    except KeyboardInterrupt:
-        interrupted = True
-    finally:
-        if bar is not None:
-            bar.close()
-    t_train = time.perf_counter() - t0
 
-    # extraction: exact features on the grid
-    t1 = time.perf_counter()
+    def step(k):
+        i_s = torch.randint(0, len(pool_s[0]), (ns,), generator=gen).to(dev)
+        i_n = torch.randint(0, len(pool_near[0]), (nb,), generator=gen).to(dev)
+        i_a = torch.randint(0, len(pool_a[0]), (nb,), generator=gen).to(dev)
+        ps, gs_ = _phi(net, cfg.n_freqs, pool_s, i_s)
+        pn, gn = _phi(net, cfg.n_freqs, pool_near, i_n)
+        l_sdf = (pn - pools["near_target"][i_n]).abs().mean()
+        pa, ga = _phi(net, cfg.n_freqs, pool_a, i_a)
+        l_sur = ps.abs().mean()
+        if nk:
+            i_k = torch.randint(0, len(pool_k[0]), (nk,), generator=gen).to(dev)
+            pk, gk = _phi(net, cfg.n_freqs, pool_k, i_k)
+            l_sur = (ns * l_sur + nk * pk.abs().mean()) / nb
+            geik = torch.cat([gs_, gn, gk])
+        else:
+            geik = torch.cat([gs_, gn])
+        l_ext = torch.exp(-cfg.ext_alpha * pa.abs()).mean()
+        l_ekl = (1.0 - geik.norm(dim=-1)).abs().mean()
+        l_nor = (gs_ - pools["normals"][i_s]).norm(dim=-1).mean()
+        loss = (cfg.w_sur * l_sur + cfg.w_ext * l_ext + cfg.w_ekl * l_ekl
+                + cfg.w_nor * l_nor + cfg.w_sdf * l_sdf)
+        return Step(loss, {"loss": float(loss.detach())})
+
+    return step
+
+
+def _extract_sdf(net, feats, cfg: CreaseConfig, dev, dtype):
+    """Marching cubes of the network's zero set on ``cfg.res``^3 nodes over [-1, 1]^3.
+
+    The features are evaluated exactly (not linearised) at the grid nodes.
+    """
+    import torch
+
+    from .extract import marching_cubes_world
+    from .feature import mollified_feature_function
+    from .sharpnet import positional_encoding
     n = cfg.res
     axis = np.linspace(-1.0, 1.0, n)
     grid = np.stack(np.meshgrid(axis, axis, axis, indexing="ij"), -1).reshape(-1, 3)
@@ -720,30 +666,18 @@ def crease_refine(vertices, faces, strokes, labels=None, *, quality: str = "draf
                                                 n_channels=feats.n_channels) * feats.scale
                 z = torch.cat([z, fv], -1)
             vals[s:s + chunk] = net.mlp(z.to(dev, dtype))[:, 0].cpu().numpy()
-    from .extract import marching_cubes_world
-    mv_, mf_ = marching_cubes_world(vals.reshape(n, n, n), np.full(3, -1.0), 2.0 / (n - 1))
-    if len(mf_):
-        ref = np.concatenate([_sample_mesh(vu, f, 50000, rng)[0], spts]) if len(spts) else \
-            _sample_mesh(vu, f, 50000, rng)[0]
-        dist, _ = cKDTree(ref).query(mv_[mf_].mean(1))
-        mf_ = mf_[dist < cfg.keep_tol]
-        usedv = np.unique(mf_)
-        remap = np.full(len(mv_), -1, dtype=np.int64)
-        remap[usedv] = np.arange(len(usedv))
-        mv_, mf_ = mv_[usedv], remap[mf_]
-    t_extract = time.perf_counter() - t1
-    report = {
-        "timings": {"setup": t_setup, "train": t_train, "extract": t_extract,
-                    "total": time.perf_counter() - t_start},
-        "n_strip_triangles": int(n_strip),
-        "n_channels": int(feats.n_channels) if feats is not None else 0,
-        "n_crease_strokes": len(creases),
-        "final_loss": loss_val,
-        "interrupted": interrupted,
-        "quality": quality,
-        "seed": int(seed),
-        "device": str(dev),
-        "config": asdict(cfg),
-        "frame": {"centre": centre.tolist(), "scale": scale},
-    }
-    return CreaseResult(mv_ * scale + centre, mf_, report)
+    return marching_cubes_world(vals.reshape(n, n, n), np.full(3, -1.0), 2.0 / (n - 1))
+
+
+def _trim_to_input(mv, mf, vu, f, spts, rng, keep_tol):
+    """Drop faces farther than ``keep_tol`` from the input surface and the stroke points."""
+    if not len(mf):
+        return mv, mf
+    ref = np.concatenate([_sample_mesh(vu, f, 50000, rng)[0], spts]) if len(spts) else \
+        _sample_mesh(vu, f, 50000, rng)[0]
+    dist, _ = cKDTree(ref).query(mv[mf].mean(1))
+    mf = mf[dist < keep_tol]
+    usedv = np.unique(mf)
+    remap = np.full(len(mv), -1, dtype=np.int64)
+    remap[usedv] = np.arange(len(usedv))
+    return mv[usedv], remap[mf]

@@ -38,8 +38,9 @@ Engineering choices (documented deviations / gap fills)
   CPU budget cannot recover from.
 * The padded box is a cube (longest side + 20 % on every side) so the grid is
   isotropic.
-* Ctrl-C (KeyboardInterrupt) stops the loop; the surface of the last completed
-  Poisson solve that crosses zero ("the best so far") is returned with
+* Ctrl-C (KeyboardInterrupt) stops the optimisation
+  (:func:`neural.training.train`); the surface of the last completed Poisson
+  solve whose f is finite ("the best so far") is returned with
   ``report["interrupted"] = True``.
 * In the full stage the Eikonal term uses surface *and* stroke samples (the
   paper names S; strokes lie on the surface too, and the published code does
@@ -48,13 +49,12 @@ Engineering choices (documented deviations / gap fills)
   stroke holds it (a capped cylinder whose caps carry no strokes becomes an
   open tube: the smoothness term prefers it); such surfaces are not watertight.
   ``boundary="dirichlet"`` closes them inside the box, but not at the rims (see
-  :class:`neural.presets.FlowConfig`). A minimal-area term (first variation of
-  the zero set's area through f) and a wall penalty were tried and did not
-  move the closure to the rims within the draft budget. The smoothness term
-  charges a rounded crease like 1 / (rounding width), so where strokes bound a
-  region without strokes it prefers tangent-continuous surfaces: its minimiser
-  for that cylinder is a capsule (F 0.58 against the flat caps), and box faces
-  bulge into pillows (``benchmarks/bench_flow_limits.py``).
+  :class:`neural.presets.FlowConfig`). The smoothness term charges a rounded
+  crease like 1 / (rounding width), so where strokes bound a region without
+  strokes it prefers tangent-continuous surfaces: its minimiser for that
+  cylinder is a capsule, and box faces bulge into pillows
+  (``benchmarks/bench_flow_limits.py`` measures both; the figures, and the
+  terms tried against it, are in ``benchmarks/README.md``).
 * Final mesh: pieces of the zero set with no stroke within 4 grid cells are
   dropped (spurious level-set components of the periodic f).
 
@@ -73,6 +73,7 @@ import numpy as np
 
 from ._inputs import check_strokes
 from .presets import FlowConfig, get_config
+from .training import Stage, Step, seeded, torch_device, train
 
 __all__ = ["FlowResult", "fit_flow_surface", "StrokeSampler", "sample_surface_cells",
            "sample_surface_marching_cubes", "Frame"]
@@ -252,24 +253,6 @@ def _sample_triangles(tri, n, rng):
     return np.einsum("nk,nkd->nd", w, tri[k])
 
 
-def _geometric_init(net, sampler, cfg, gen, lr=1e-3):
-    """Fit g to ``sigma (x - c) / |x - c|`` (c: stroke centroid); see module notes."""
-    import torch
-    dev, dtype = sampler.a.device, sampler.a.dtype
-    c = sampler.sample(4096, gen)[0].mean(0)
-    opt = torch.optim.Adam(net.parameters(), lr=lr)
-    n = max(cfg.n_volume, 1000)
-    for _ in range(cfg.geometric_init_steps):
-        x = torch.cat([torch.rand(n, 3, generator=gen, device=dev, dtype=dtype),
-                       sampler.sample(n, gen)[0]])
-        d = x - c
-        target = cfg.sigma * d / d.norm(dim=-1, keepdim=True).clamp(min=1e-6)
-        opt.zero_grad(set_to_none=True)
-        loss = ((net(x) - target) ** 2).sum(-1).mean()
-        loss.backward()
-        opt.step()
-
-
 def _prefit_targets(init_mesh, frame: Frame, sigma, rng, n=20000):
     """Unit-cube points and targets sigma * grad SDF of a mesh (refinement)."""
     import igl
@@ -322,8 +305,9 @@ def fit_flow_surface(strokes, *, labels=None, quality: str = "draft", device="cp
     init_mesh : (vertices (V, 3), faces (F, 3)), optional
         A classical surface to refine: g is first regressed on ``sigma`` times
         the gradient of its signed distance (``prefit_steps``; no curl term: the
-        target is a gradient, and a curl penalty on the random SIREN collapsed g
-        to a constant), then the full stage runs (no initialisation stage).
+        target is already a gradient, and a curl penalty on the random initial
+        SIREN drives g to a constant), then the full stage runs (no
+        initialisation stage).
     progress : bool
         Show a tqdm bar with the loss terms.
     cut_boundary : bool
@@ -350,197 +334,243 @@ def fit_flow_surface(strokes, *, labels=None, quality: str = "draft", device="cp
     >>> res.report["interrupted"]                                          # doctest: +SKIP
     False
     """
-    import torch
-
     cfg = get_config(quality, **overrides)
     strokes, labels = _check_strokes(strokes, labels)
-    try:
-        dev = torch.device(device)
-    except (RuntimeError, TypeError) as exc:
-        raise ValueError(f"device must be 'cpu' or 'cuda', got {device!r}") from exc
-    if dev.type == "cuda" and not torch.cuda.is_available():
-        raise ValueError(f"device {device!r} requested but CUDA is not available")
-    if dev.type not in ("cpu", "cuda"):
-        raise ValueError(f"device must be 'cpu' or 'cuda', got {device!r}")
+    dev = torch_device(device)
     return _fit(strokes, labels, cfg, dev, int(seed), init_mesh, progress, cut_boundary, quality)
 
 
-def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_boundary, quality):
-    import torch
+class _FlowFit:
+    """One flow fit: the network, the samplers, the Poisson solver and the current f.
 
-    from .extract import cut_along_boundary, keep_supported_components, marching_cubes_world
-    from .losses import (alignment_loss, curl_loss, data_loss, eikonal_loss, smoothness_loss,
-                         smoothness_loss_autograd)
-    from .poisson import (PoissonSolver, interpolate, normalize_scale_shift, normalize_splat,
-                          splat)
-    from .siren import GradientSiren
+    Its step functions (:meth:`stages`) are run by :func:`neural.training.train`.
+    """
 
-    t_start = time.perf_counter()
-    dtype = torch.float64 if cfg.dtype == "float64" else torch.float32
-    frame = Frame.from_points(np.vstack(strokes), cfg.padding)
-    res = cfg.res
-    strokes_unit = [frame.to_unit(s) for s in strokes]
+    def __init__(self, strokes, cfg: FlowConfig, dev, seed: int, init_mesh):
+        import torch
 
-    torch.manual_seed(seed)
-    gen = torch.Generator(device=dev)
-    gen.manual_seed(seed)
-    rng = np.random.default_rng(seed)
-    net = GradientSiren(cfg.width, cfg.hidden_layers, cfg.omega_0).to(device=dev, dtype=dtype)
-    sampler = StrokeSampler(strokes_unit, dev, dtype)
-    if init_mesh is None and cfg.geometric_init_steps > 0:
-        _geometric_init(net, sampler, cfg, gen)
-    opt = torch.optim.Adam(net.parameters(), lr=cfg.lr)
-    solver = PoissonSolver(res, device=dev, dtype=dtype, smooth_cells=cfg.smooth_cells,
-                           boundary=cfg.boundary)
+        from .poisson import PoissonSolver
+        from .siren import GradientSiren
 
-    stages = []
-    if init_mesh is not None:
-        P, target, mesh_surf = _prefit_targets(init_mesh, frame, cfg.sigma, rng)
-        P = torch.as_tensor(P, device=dev, dtype=dtype)
-        target = torch.as_tensor(target, device=dev, dtype=dtype)
-        stages.append(("prefit", cfg.prefit_steps))
-    else:
-        stages.append(("init", cfg.init_steps))
-    stages.append(("full", cfg.steps))
-    history = {name: {k: [] for k in _TERMS} for name, _ in stages}
-    timings = {name: 0.0 for name, _ in stages}
-    steps_done = {name: 0 for name, _ in stages}
-    total_steps = sum(n for _, n in stages)
+        self.cfg, self.dev = cfg, dev
+        self.dtype = torch.float64 if cfg.dtype == "float64" else torch.float32
+        self.frame = Frame.from_points(np.vstack(strokes), cfg.padding)
+        strokes_unit = [self.frame.to_unit(s) for s in strokes]
+        self.gen, self.rng = seeded(seed, dev)
+        self.net = GradientSiren(cfg.width, cfg.hidden_layers, cfg.omega_0).to(
+            device=dev, dtype=self.dtype)
+        self.sampler = StrokeSampler(strokes_unit, dev, self.dtype)
+        self.solver = PoissonSolver(cfg.res, device=dev, dtype=self.dtype,
+                                    smooth_cells=cfg.smooth_cells, boundary=cfg.boundary)
+        self.f = None                  # the last solved f (unit-cube grid)
+        self.lam = None                # d(data loss) / d(splat), for poisson_every > 1
+        self.data = float("nan")       # the last solved data loss
+        self.prefit = None
+        if init_mesh is not None:
+            P, target, mesh_surf = _prefit_targets(init_mesh, self.frame, cfg.sigma, self.rng)
+            self.prefit = (torch.as_tensor(P, device=dev, dtype=self.dtype),
+                           torch.as_tensor(target, device=dev, dtype=self.dtype), mesh_surf)
+        names = ("prefit",) if init_mesh is not None else ("init",)
+        self.history = {name: {t: [] for t in _TERMS} for name in names + ("full",)}
 
-    state = {"f": None, "f_best": None, "lam": None, "data": float("nan")}
+    def geometric_stage(self) -> Stage:
+        """Fit g to ``sigma (x - c) / |x - c|`` (c: stroke centroid); see the module notes."""
+        import torch
+        cfg, gen, dev, dtype = self.cfg, self.gen, self.dev, self.dtype
+        c = self.sampler.sample(4096, gen)[0].mean(0)
+        n = max(cfg.n_volume, 1000)
 
-    def solve(points, values, normalize, need_adjoint):
+        def step(k):
+            x = torch.cat([torch.rand(n, 3, generator=gen, device=dev, dtype=dtype),
+                           self.sampler.sample(n, gen)[0]])
+            d = x - c
+            target = cfg.sigma * d / d.norm(dim=-1, keepdim=True).clamp(min=1e-6)
+            return Step(((self.net(x) - target) ** 2).sum(-1).mean())
+
+        return Stage("geometric", cfg.geometric_init_steps, step)
+
+    def stages(self) -> list:
+        """The prefit (``init_mesh`` given) or initialisation stage, then the full stage."""
+        cfg = self.cfg
+        if self.prefit is not None:
+            first = Stage("prefit", cfg.prefit_steps, self._prefit_step)
+            full = Stage("full", cfg.steps, self._flow_step("full", cfg.steps),
+                         start=self._bootstrap)
+        else:
+            first = Stage("init", cfg.init_steps, self._flow_step("init", cfg.init_steps))
+            full = Stage("full", cfg.steps, self._flow_step("full", cfg.steps))
+        return [first, full]
+
+    def solve(self, points, values, normalize, need_adjoint):
         """Splat -> FFT Poisson -> Eq. 11; returns (f_grid, data loss, raw grid)."""
-        grid, wsum = splat(points, values, res)
+        from .losses import data_loss
+        from .poisson import interpolate, normalize_scale_shift, normalize_splat, splat
+        grid, wsum = splat(points, values, self.cfg.res)
         raw = grid
         if need_adjoint:
             raw.retain_grad()
         if normalize:
             grid = normalize_splat(grid, wsum)
-        f = solver.solve(grid)
-        x_eval = points[: n_str_eval]
-        f_s = interpolate(f, x_eval)
+        f = self.solver.solve(grid)
+        f_s = interpolate(f, points[: self.cfg.n_stroke])
         f, f_s = normalize_scale_shift(f, f_s)
         return f, data_loss(f_s), raw
 
-    def surface_samples(n):
-        if state["f"] is None:
-            return None
-        if cfg.surface_sampler == "cells":
-            return sample_surface_cells(state["f"], n, gen)
-        p = sample_surface_marching_cubes(state["f"], n, rng)
-        return None if p is None else torch.as_tensor(p, device=dev, dtype=dtype)
+    def solve_strokes_only(self, mesh_points=None):
+        """f integrated from g at stroke samples (and ``mesh_points``), without gradients."""
+        import torch
+        with torch.no_grad():
+            pts, _ = self.sampler.sample(self.cfg.n_stroke, self.gen)
+            if mesh_points is not None:
+                pts = torch.cat([pts, mesh_points])
+            return self.solve(pts, self.net(pts), False, False)[0]
 
-    bar = None
-    if progress:
-        from tqdm.auto import tqdm
-        bar = tqdm(total=total_steps, desc="neural", unit="step", leave=False)
-    interrupted = False
-    n_str_eval = cfg.n_stroke
-    global_step = 0
-    try:
-        for stage, n_steps in stages:
-            t0 = time.perf_counter()
-            if stage == "full" and init_mesh is not None and state["f"] is None:
-                # bootstrap f from the prefitted g on strokes + mesh samples
-                with torch.no_grad():
-                    xs, _ = sampler.sample(cfg.n_stroke, gen)
-                    ms = torch.as_tensor(mesh_surf[: cfg.n_surface], device=dev, dtype=dtype)
-                    pts = torch.cat([xs, ms])
-                    f, _, _ = solve(pts, net(pts), False, False)
-                    state["f"] = state["f_best"] = f
-            for k in range(n_steps):
-                opt.zero_grad(set_to_none=True)
-                vals = {}
-                if stage == "prefit":
-                    idx = torch.randint(len(P), (cfg.n_volume,), generator=gen, device=dev)
-                    x = P[idx]
-                    loss = ((net(x) - target[idx]) ** 2).sum(-1).mean()
-                    vals["total"] = loss
-                else:
-                    full = stage == "full"
-                    x_s, t_s = sampler.sample(cfg.n_stroke, gen)
-                    x_v = torch.rand(cfg.n_volume, 3, generator=gen, device=dev, dtype=dtype)
-                    g_sv, G_sv = net.jet(torch.cat([x_s, x_v]), order=1)
-                    g_s, G_s = g_sv[: cfg.n_stroke], G_sv[: cfg.n_stroke]
-                    G_v = G_sv[cfg.n_stroke:]
-                    x_u = surface_samples(cfg.n_surface) if full else None
-                    vals["align"] = alignment_loss(g_s, G_s, t_s)
-                    vals["curl"] = curl_loss(G_v)
-                    if x_u is not None:
-                        use_jet2 = cfg.w_smooth > 0 and cfg.smooth_mode == "jet"
-                        if use_jet2:
-                            g_u, G_u, H_u = net.jet(x_u, order=2)
-                            vals["smooth"] = smoothness_loss(g_u, G_u, H_u)
-                        else:
-                            g_u = net(x_u)
-                            if cfg.w_smooth > 0:
-                                vals["smooth"] = smoothness_loss_autograd(net, x_u)
-                        vals["eik"] = eikonal_loss(torch.cat([g_u, g_s]), cfg.sigma)
-                        pts, gv = torch.cat([x_s, x_u]), torch.cat([g_s, g_u])
-                    else:
-                        vals["eik"] = eikonal_loss(g_s, cfg.sigma)
-                        pts, gv = x_s, g_s
-                    if cfg.splat_volume:
-                        pts, gv = torch.cat([pts, x_v]), torch.cat([gv, g_sv[cfg.n_stroke:]])
-                    normalize = full and k >= int(cfg.normalize_from * n_steps)
-                    last = k == n_steps - 1
-                    do_solve = (k % cfg.poisson_every == 0) or last or state["lam"] is None
-                    if do_solve:
-                        f, dl, raw = solve(pts, gv, normalize, cfg.poisson_every > 1)
-                        vals["data"] = dl
-                        data_term = cfg.w_data * dl
-                    else:
-                        grid, _ = splat(pts, gv, res)
-                        data_term = (state["lam"] * grid).sum()
-                    loss = (cfg.w_align * vals["align"] + cfg.w_curl * vals["curl"]
-                            + cfg.w_eik * vals["eik"] + data_term)
-                    if "smooth" in vals:
-                        loss = loss + cfg.w_smooth * vals["smooth"]
-                    vals["total"] = loss
-                loss.backward()
-                if cfg.grad_clip > 0:
-                    torch.nn.utils.clip_grad_norm_(net.parameters(), cfg.grad_clip)
-                opt.step()
-                if stage != "prefit" and do_solve:
+    def _bootstrap(self):
+        """f from the prefitted g on strokes + init-mesh samples (start of the full stage)."""
+        import torch
+        ms = torch.as_tensor(self.prefit[2][: self.cfg.n_surface], device=self.dev,
+                             dtype=self.dtype)
+        self.f = self.solve_strokes_only(ms)
+        return self.f
+
+    def _surface_samples(self, n):
+        import torch
+        if self.f is None:
+            return None
+        if self.cfg.surface_sampler == "cells":
+            return sample_surface_cells(self.f, n, self.gen)
+        p = sample_surface_marching_cubes(self.f, n, self.rng)
+        return None if p is None else torch.as_tensor(p, device=self.dev, dtype=self.dtype)
+
+    def _prefit_step(self, k):
+        import torch
+        P, target, _ = self.prefit
+        idx = torch.randint(len(P), (self.cfg.n_volume,), generator=self.gen, device=self.dev)
+        loss = ((self.net(P[idx]) - target[idx]) ** 2).sum(-1).mean()
+        row = self._row({"total": loss})
+        return Step(loss, dict(zip(_TERMS, row)), after=lambda: self._record("prefit", k, row))
+
+    def _flow_step(self, stage, n_steps):
+        """Step function of the initialisation (strokes only) or full stage (Eq. 13)."""
+        import torch
+
+        from .losses import alignment_loss, curl_loss
+        from .poisson import splat
+        cfg, net, gen = self.cfg, self.net, self.gen
+        full = stage == "full"
+
+        def step(k):
+            x_s, t_s = self.sampler.sample(cfg.n_stroke, gen)
+            x_v = torch.rand(cfg.n_volume, 3, generator=gen, device=self.dev, dtype=self.dtype)
+            g_sv, G_sv = net.jet(torch.cat([x_s, x_v]), order=1)
+            g_s, G_s = g_sv[: cfg.n_stroke], G_sv[: cfg.n_stroke]
+            x_u = self._surface_samples(cfg.n_surface) if full else None
+            vals = {"align": alignment_loss(g_s, G_s, t_s), "curl": curl_loss(G_sv[cfg.n_stroke:])}
+            pts, gv = self._surface_terms(vals, x_u, x_s, g_s)
+            if cfg.splat_volume:
+                pts, gv = torch.cat([pts, x_v]), torch.cat([gv, g_sv[cfg.n_stroke:]])
+            normalize = full and k >= int(cfg.normalize_from * n_steps)
+            do_solve = (k % cfg.poisson_every == 0) or k == n_steps - 1 or self.lam is None
+            if do_solve:
+                f, vals["data"], raw = self.solve(pts, gv, normalize, cfg.poisson_every > 1)
+                data_term = cfg.w_data * vals["data"]
+            else:
+                data_term = (self.lam * splat(pts, gv, cfg.res)[0]).sum()
+            loss = (cfg.w_align * vals["align"] + cfg.w_curl * vals["curl"]
+                    + cfg.w_eik * vals["eik"] + data_term)
+            if "smooth" in vals:
+                loss = loss + cfg.w_smooth * vals["smooth"]
+            vals["total"] = loss
+            row = self._row(vals)
+            if do_solve:
+                row[3] = float(vals["data"].detach())
+                f = f.detach()
+            else:
+                row[3] = self.data
+
+            def after():
+                if do_solve:
                     if cfg.poisson_every > 1:
-                        state["lam"] = raw.grad.detach()
-                    state["f"] = f.detach()
-                    if bool(torch.isfinite(state["f"]).all()):
-                        state["f_best"] = state["f"]
-                    state["data"] = float(vals["data"].detach())
-                row = torch.stack([vals[t].detach() if t in vals else
-                                   torch.full((), float("nan"), device=dev, dtype=dtype)
-                                   for t in _TERMS]).tolist()
-                if stage != "prefit":
-                    row[3] = state["data"]
-                for t, v in zip(_TERMS, row):
-                    history[stage][t].append(v)
-                steps_done[stage] += 1
-                global_step += 1
-                if bar is not None:
-                    bar.update(1)
-                    bar.set_postfix({"stage": stage, **{t: f"{v:.3g}" for t, v in zip(_TERMS, row)
-                                                        if v == v}}, refresh=False)
-                if not all(np.isfinite(v) for v in row if v == v):
-                    raise FloatingPointError(f"non-finite loss at {stage} step {k}: {row}")
-            timings[stage] = time.perf_counter() - t0
-    except KeyboardInterrupt:
-        interrupted = True
-    finally:
-        if bar is not None:
-            bar.close()
+                        self.lam = raw.grad.detach()
+                    self.f, self.data = f, row[3]
+                self._record(stage, k, row)
+
+            return Step(loss, dict(zip(_TERMS, row)), state=f if do_solve else None,
+                        after=after)
+
+        return step
+
+    def _surface_terms(self, vals, x_u, x_s, g_s):
+        """Smoothness and Eikonal terms into ``vals``; the points and g to splat."""
+        import torch
+
+        from .losses import eikonal_loss, smoothness_loss, smoothness_loss_autograd
+        cfg, net = self.cfg, self.net
+        if x_u is None:
+            vals["eik"] = eikonal_loss(g_s, cfg.sigma)
+            return x_s, g_s
+        if cfg.w_smooth > 0 and cfg.smooth_mode == "jet":
+            g_u, G_u, H_u = net.jet(x_u, order=2)
+            vals["smooth"] = smoothness_loss(g_u, G_u, H_u)
+        else:
+            g_u = net(x_u)
+            if cfg.w_smooth > 0:
+                vals["smooth"] = smoothness_loss_autograd(net, x_u)
+        vals["eik"] = eikonal_loss(torch.cat([g_u, g_s]), cfg.sigma)
+        return torch.cat([x_s, x_u]), torch.cat([g_s, g_u])
+
+    def _row(self, vals) -> list:
+        """The loss terms of :data:`_TERMS` as floats (NaN where not computed)."""
+        import torch
+        nan = torch.full((), float("nan"), device=self.dev, dtype=self.dtype)
+        return torch.stack([vals[t].detach() if t in vals else nan for t in _TERMS]).tolist()
+
+    def _record(self, stage, k, row):
+        for t, v in zip(_TERMS, row):
+            self.history[stage][t].append(v)
+        if not all(np.isfinite(v) for v in row if v == v):
+            raise FloatingPointError(f"non-finite loss at {stage} step {k}: {row}")
+
+
+def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_boundary, quality):
+    t_start = time.perf_counter()
+    fit = _FlowFit(strokes, cfg, dev, seed, init_mesh)
+    stages = fit.stages()
+    interrupted = False
+    if init_mesh is None and cfg.geometric_init_steps > 0:
+        interrupted = train(fit.net.parameters(), [fit.geometric_stage()], lr=1e-3).interrupted
+    run = train(fit.net.parameters(), [] if interrupted else stages, lr=cfg.lr,
+                grad_clip=cfg.grad_clip, progress=progress, desc="neural")
+    interrupted = interrupted or run.interrupted
+    timings = {s.name: run.timings.get(s.name, 0.0) for s in stages}
+    steps_done = {s.name: run.steps.get(s.name, 0) for s in stages}
 
     t0 = time.perf_counter()
-    f_final = state["f_best"] if interrupted else state["f"]
-    if f_final is None:
-        with torch.no_grad():
-            xs, _ = sampler.sample(cfg.n_stroke, gen)
-            f_final, _, _ = solve(xs, net(xs), False, False)
+    f_final = run.best if run.best is not None else fit.solve_strokes_only()
+    V, F, f_np, origin, h_world, n_cut = _extract(f_final, fit.frame, strokes, labels,
+                                                  cut_boundary)
+    timings["extract"] = time.perf_counter() - t0
+    timings["total"] = time.perf_counter() - t_start
+    report = {"steps": steps_done, "interrupted": interrupted, "device": str(dev), "seed": seed,
+              "quality": quality, "config": cfg.as_dict(), "n_vertices": len(V),
+              "n_faces": len(F), "cut_faces": n_cut,
+              "stroke_length_unit": fit.sampler.total_length}
+    return FlowResult(V, F, f_np, origin, h_world, timings, fit.history, report)
+
+
+def _extract(f_final, frame: Frame, strokes, labels, cut_boundary):
+    """World mesh of f's zero set: supported components, cut along boundary strokes.
+
+    Returns ``(V, F, f_np, origin, spacing, n_cut_faces)``; ``f_np`` is signed so that
+    the box corner (outside) is positive.
+    """
+    import torch
+
+    from .extract import cut_along_boundary, keep_supported_components, marching_cubes_world
     f_np = f_final.detach().to("cpu", torch.float32).numpy()
     if f_np[0, 0, 0] < 0:        # the box corner is outside: make f > 0 outside
         f_np = -f_np
-    h_world = frame.side / res
+    h_world = frame.side / f_np.shape[0]
     origin = frame.box_min + 0.5 * h_world
     V, F = marching_cubes_world(f_np, origin, h_world)
     V, F = keep_supported_components(V, F, strokes, 4.0 * h_world)
@@ -549,10 +579,4 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
         V, F = cut_along_boundary(V, F, [s for s, lab in zip(strokes, labels) if lab == "boundary"],
                                   [s for s, lab in zip(strokes, labels) if lab != "boundary"],
                                   1.5 * h_world)
-    timings["extract"] = time.perf_counter() - t0
-    timings["total"] = time.perf_counter() - t_start
-    report = {"steps": steps_done, "interrupted": interrupted, "device": str(dev), "seed": seed,
-              "quality": quality, "config": cfg.as_dict(), "n_vertices": len(V),
-              "n_faces": len(F), "cut_faces": n_before_cut - len(F),
-              "stroke_length_unit": sampler.total_length}
-    return FlowResult(V, F, f_np, origin, h_world, timings, history, report)
+    return V, F, f_np, origin, h_world, n_before_cut - len(F)

@@ -1,50 +1,44 @@
-"""Quality presets for the flow-aligned neural surfacing (Zhang, Wang, Bessmeltsev 2025).
+"""Quality presets of the neural fits: every setting in one place, overridable by keyword.
 
-A preset is a :class:`FlowConfig`: every setting of the optimisation in one
-place, each overridable by keyword (``fit_flow_surface(..., res=96)``).
+A :class:`FlowConfig` holds the settings of the flow-aligned surfacing (Zhang, Wang,
+Bessmeltsev 2025; :func:`neural.flow.fit_flow_surface`), a :class:`CreaseConfig` those
+of the crease refit (Niu et al. 2025; :func:`neural.creases.crease_refine`). Each has
+three presets, ``draft``, ``default`` and ``paper`` (``fit_flow_surface(..., res=96)``
+overrides one field of the chosen preset).
 
 Notes
 -----
-``paper`` reproduces the published settings (Sec. 4.3, 5.1, 5.2): a 4 x 256
-SIREN with omega_0 = 30, 10k / 15k / 15k Monte-Carlo samples on strokes,
-surface and volume, 200 initialisation + 800 full Adam steps, a 256^3 grid on
-the bounding box padded by 20 %, loss weights 1, 0.01, 30, 7, 7 and Eikonal
-sigma = 0.5. The learning rate and gradient clipping are not given in the
-paper; we take the published code's values (Adam lr 5e-5, clip 10). It is
-meant for a GPU: 44-58 s per sketch on one H100 (0.05-0.06 s per full step at
-128^3 and 256^3 alike, 5.5 GB of GPU memory).
+Flow presets. ``paper`` reproduces the published settings (Sec. 4.3, 5.1, 5.2): a
+4 x 256 SIREN with omega_0 = 30, 10k / 15k / 15k Monte-Carlo samples on strokes,
+surface and volume, 200 initialisation + 800 full Adam steps, a 256^3 grid on the
+bounding box padded by 20 %, loss weights 1, 0.01, 30, 7, 7 and Eikonal sigma = 0.5.
+The learning rate and gradient clipping are not given in the paper; it takes the
+published code's values (Adam lr 5e-5, clip 10). It is meant for a GPU.
 
-``draft`` is sized for a 2-core CPU in about a minute; ``default`` balances
-quality and time (a tenth of the reference's time on a CPU; 12-13 s per vns
-sketch on an H100). Both raise the smoothness weight from the paper's 0.01 to
-0.1: with their short budgets the paper's weight leaves mid-frequency bumps.
-Measured on rough re-drawn shapes at draft (seed 0, F-score at 0.01): sphere
-0.923 -> 0.994, ellipsoid 0.950 -> 0.978, torus 0.734 -> 0.953, capped
-cylinder 0.568 -> 0.635.
-
-On a GPU, ``default`` is the better choice in this implementation. Rough
-shapes on an H100 (seed 0, F-score at 0.01): ``default`` sphere 0.999 in 7.7 s;
-``paper`` sphere 0.701 (faceted between the strokes), ellipsoid 0.987, torus
-0.960 (a small hole at the box wall). No change of ``paper`` was better on all
-three: sphere / ellipsoid / torus with the smoothness weight 0.1 and the
-published code's sphere initialisation 0.999 / 1.000 / 0.580 (torus genus
-lost); 0.1 alone 1.000 / 0.998 / 0.783; the sphere initialisation alone 0.719
-(sphere), 0.578 (torus); lr 2e-4 0.373, a 128^3 grid 0.739, a Gaussian
-low-pass of one cell 0.676 (torus). ``paper`` therefore keeps the published
-constants. Both solve the Poisson equation every ``poisson_every`` steps and
-use the linearised data term in between (see :mod:`neural.flow`).
+``draft`` is sized for a short CPU run (a 64^3 grid and a small network), ``default``
+balances quality and time (128^3) and is the better choice on a GPU. Both raise the
+smoothness weight from the paper's 0.01 to 0.1 and start from a radial geometric
+initialisation: with their short budgets the paper's weight leaves mid-frequency
+bumps, and the plain SIREN initialisation starts from a rough field they cannot
+recover from. ``paper`` keeps the published constants (no variant tried was better on
+every test shape). All presets solve the Poisson equation every ``poisson_every`` steps
+and use the linearised data term in between (see :mod:`neural.flow`).
+``benchmarks/README.md`` has the scores and timings of the presets and of the
+variants tried.
 
 References
 ----------
 Zhang, Wang, Bessmeltsev, "Variational Neural Surfacing of 3D Sketches",
 SIGGRAPH Asia 2025, Sec. 4.3 (weights), 5.1 (samples), 5.2 (steps).
+Niu et al. 2025, "SharpNet", Sec. 5 (network size and training of the 3D examples).
 """
 
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, fields, replace
 
-__all__ = ["FlowConfig", "PRESETS", "get_config", "parse_setting"]
+__all__ = ["FlowConfig", "PRESETS", "get_config", "parse_setting", "CreaseConfig",
+           "CREASE_PRESETS", "crease_config"]
 
 
 @dataclass(frozen=True)
@@ -59,20 +53,14 @@ class FlowConfig:
         Padding of the sketch's bounding box on every side, as a fraction of its
         longest side (paper: 0.2, Sec. 4.4.1).
     boundary : str
-        ``"periodic"`` (the paper: the padded box is a 3-torus) or ``"dirichlet"``
-        (f = 0 on the box walls, a sine series: one solve takes 0.01 s vs 0.007 s
-        at 64^3, 0.11 s vs 0.05 s at 128^3 and 2.8-3.9 s vs 0.6-0.7 s at 256^3 on
-        2 CPU cores, with less memory than the FFT). On the torus a zero set may
-        close by wrapping around the box where no stroke holds it: the rough
-        capped cylinder, whose caps carry no strokes, comes out as a tube through
-        the walls (not watertight; F-score 0.64 at draft).
-        ``"dirichlet"`` makes the walls outside, so every surface closes inside
-        the box: the same cylinder becomes watertight with genus 0, but its ends
-        close as domes in the padding (F-score 0.54, Chamfer 0.040 vs 0.046, 17 s
-        vs 13 s at draft); nothing in the energy puts the closure at the rims.
-        Other rough shapes at draft, dirichlet vs periodic: sphere 0.992 vs 0.996,
-        ellipsoid 0.993 vs 0.978, torus 0.881 vs 0.953; rough box normal error
-        20.1 vs 27.8 degrees (its faces no longer bulge through the walls).
+        ``"periodic"`` (the paper: the padded box is a 3-torus, the FFT solve) or
+        ``"dirichlet"`` (f = 0 on the box walls, a sine series: slower per solve at
+        large grids, with less memory than the FFT). On the torus a zero set may
+        close by wrapping around the box where no stroke holds it (a capped
+        cylinder whose caps carry no strokes becomes a tube through the walls, not
+        watertight). ``"dirichlet"`` makes the walls outside, so every surface
+        closes inside the box, but nothing in the energy puts the closure at the
+        strokes' rims: such ends close as domes in the padding.
     width, hidden_layers : int
         SIREN hidden width and number of hidden (width -> width) layers
         (paper: 256 and 4, Sec. 4.4).
@@ -113,10 +101,9 @@ class FlowConfig:
     splat_volume : bool
         Also splat g at the volume samples into the Poisson right-hand side, so
         that f follows g away from the surface too (the paper splats stroke and
-        surface samples only, Sec. 5.1; without the volume samples the zero set
-        can escape through the periodic box where no stroke holds it, e.g. a
-        capped cylinder becomes an infinite tube). Off by default: it did not
-        close that tube in our tests (the smoothness term itself prefers it).
+        surface samples only, Sec. 5.1). Off by default: it does not keep a zero
+        set from closing through the periodic box, because the smoothness term
+        itself prefers that surface.
     dtype : str
         ``"float32"`` or ``"float64"``.
     """
@@ -269,3 +256,118 @@ def parse_setting(text: str) -> tuple[str, object]:
         return name, kind(raw)
     except ValueError:
         raise ValueError(f"{name} takes a {kind.__name__}, got {raw!r}") from None
+
+
+# ---------------------------------------------------------------------------------------------
+# crease refit (neural.creases.crease_refine)
+# ---------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class CreaseConfig:
+    """Settings of :func:`neural.creases.crease_refine` (lengths in its unit frame:
+    the data in [-0.8, 0.8]^3).
+
+    Attributes
+    ----------
+    hidden, layers : int
+        SharpNet MLP size (paper Sec. 5: 4 x 256).
+    activation : {"softplus", "sine"}
+        Softplus(beta = 100) (Sec. 4) or SIREN sine (Sec. 5).
+    n_freqs : int
+        Positional-encoding octaves.
+    geometric_init : float or None
+        Radius of the initial sphere SDF (Softplus; see :class:`neural.sharpnet.SharpNet`).
+    steps, lr, batch : Adam steps, learning rate, surface points per step (the ambient
+        and near-surface batches have the same size).
+    res : int
+        Marching-cubes grid per axis over [-1, 1]^3.
+    strip_width : float
+        Half-width w of the crease strips (Appendix A).
+    strip_spacing : float
+        Strip element size along the stroke.
+    mollifier_radius : float
+        Support radius of each strip triangle's mollifier (Eq. 6).
+    feature_scale : float
+        Multiplier of the feature channels (network input scaling).
+    exclude : float
+        Surface samples of the input mesh closer than this to a crease stroke are dropped
+        (the input is rounded there); the strokes themselves constrain the crease.
+    guide_radius : float
+        Neighbourhood for the guide estimate from the input surface normals.
+    w_sur, w_ext, w_ekl, w_nor : float
+        Loss weights of Eq. 9 (``w_nor`` as in Eq. 10).
+    w_sdf : float
+        Weight of the value term on near-surface samples (not in the paper; see
+        :func:`neural.creases.crease_refine`).
+    ext_alpha : float
+        alpha of ``L_ext = exp(-alpha |Phi|)`` (not given in the paper; SIREN uses 100).
+    near_sigma : float
+        Std of the Gaussian offsets of the near-surface (Eikonal) samples.
+    pool : int
+        Surface samples drawn once from the input (their feature values are computed once).
+    stroke_weight : float
+        Share of the surface batch taken from stroke points.
+    use_features : bool
+        False fits the same network without feature channels (the no-crease baseline).
+    keep_tol : float
+        Output faces farther than this from the input surface and strokes are dropped
+        (removes stray level-set pieces; trims open surfaces to their input extent).
+    """
+
+    hidden: int = 128
+    layers: int = 3
+    activation: str = "softplus"
+    n_freqs: int = 2
+    geometric_init: float | None = 0.5
+    steps: int = 800
+    lr: float = 2e-3
+    batch: int = 3000
+    res: int = 128
+    strip_width: float = 0.08
+    strip_spacing: float = 0.025
+    mollifier_radius: float = 0.1
+    feature_scale: float = 10.0
+    exclude: float = 0.1
+    guide_radius: float = 0.12
+    w_sur: float = 7000.0
+    w_ext: float = 600.0
+    w_ekl: float = 50.0
+    w_nor: float = 15.0
+    w_sdf: float = 3000.0
+    ext_alpha: float = 100.0
+    near_sigma: float = 0.03
+    pool: int = 60000
+    stroke_weight: float = 0.2
+    use_features: bool = True
+    keep_tol: float = 0.1
+
+
+CREASE_PRESETS = {
+    "draft": CreaseConfig(),
+    "default": CreaseConfig(hidden=256, layers=4, steps=3000, res=192, pool=150000),
+    "paper": CreaseConfig(hidden=256, layers=4, steps=15000, res=256, pool=300000,
+                          batch=20000),
+}
+
+
+def crease_config(quality: str = "draft", overrides: dict | None = None) -> CreaseConfig:
+    """The preset ``quality`` with ``overrides`` (field name -> value) applied and checked.
+
+    Raises
+    ------
+    ValueError
+        Unknown preset or field, or a value out of range.
+    """
+    overrides = overrides or {}
+    if quality not in CREASE_PRESETS:
+        raise ValueError(f"quality must be one of {sorted(CREASE_PRESETS)}, got {quality!r}")
+    names = {f.name for f in fields(CreaseConfig)}
+    bad = sorted(set(overrides) - names)
+    if bad:
+        raise ValueError(f"unknown crease_refine setting(s) {bad}; known: {sorted(names)}")
+    cfg = replace(CREASE_PRESETS[quality], **overrides)
+    if cfg.activation not in ("softplus", "sine"):
+        raise ValueError(f"activation must be 'softplus' or 'sine', got {cfg.activation!r}")
+    for k in ("steps", "batch", "res", "pool", "hidden", "layers"):
+        if int(getattr(cfg, k)) < 1:
+            raise ValueError(f"{k} must be >= 1, got {getattr(cfg, k)!r}")
+    return cfg

@@ -1,0 +1,133 @@
+"""The shared optimisation loop of the neural fits (neural.training)."""
+
+import numpy as np
+import pytest
+import torch
+
+from curvenet.neural.training import Stage, Step, seeded, torch_device, train
+
+TARGET = torch.tensor([1.0, -2.0, 0.5])
+
+
+def _quadratic(x, fail_at=None, nan_from=None):
+    """Step function of |x - TARGET|^2 offering x as the state; raises / poisons on request."""
+
+    def step(k):
+        if k == fail_at:
+            raise KeyboardInterrupt
+        state = x.detach().clone()
+        if nan_from is not None and k >= nan_from:
+            state = state * float("nan")
+        loss = ((x - TARGET) ** 2).sum()
+        return Step(loss, {"loss": float(loss.detach())}, state=state)
+
+    return step
+
+
+def _hand_written_adam(x0, steps, lr):
+    """The reference: plain Adam on the same quadratic, states after every step."""
+    x = torch.nn.Parameter(x0.clone())
+    opt = torch.optim.Adam([x], lr=lr)
+    states = []
+    for _ in range(steps):
+        opt.zero_grad()
+        ((x - TARGET) ** 2).sum().backward()
+        opt.step()
+        states.append(x.detach().clone())
+    return states
+
+
+def test_minimises_a_quadratic_like_hand_written_adam():
+    x = torch.nn.Parameter(torch.zeros(3))
+    out = train([x], [Stage("fit", 300, _quadratic(x))], lr=0.05)
+    assert not out.interrupted and out.steps == {"fit": 300}
+    assert torch.allclose(x.detach(), TARGET, atol=1e-3)
+    # the offered state is taken before the step: the best is the state of the last step
+    ref = _hand_written_adam(torch.zeros(3), 300, 0.05)
+    assert torch.equal(out.best, ref[-2]) and torch.equal(x.detach(), ref[-1])
+    assert out.log["loss"] < 1e-5
+
+
+def test_keyboard_interrupt_returns_best_so_far():
+    x = torch.nn.Parameter(torch.zeros(3))
+    out = train([x], [Stage("a", 5, _quadratic(x)), Stage("b", 10, _quadratic(x, fail_at=4))],
+                lr=0.05)
+    assert out.interrupted
+    assert out.steps == {"a": 5, "b": 4}
+    assert out.timings["a"] > 0 and out.timings["b"] == 0.0   # "b" did not run to its end
+    # 9 completed steps; the last offered state is x after 8 steps
+    assert torch.equal(out.best, _hand_written_adam(torch.zeros(3), 8, 0.05)[-1])
+
+
+def test_non_finite_states_are_not_kept():
+    x = torch.nn.Parameter(torch.zeros(3))
+    out = train([x], [Stage("fit", 10, _quadratic(x, nan_from=6))], lr=0.05)
+    assert torch.isfinite(out.best).all()
+    assert torch.equal(out.best, _hand_written_adam(torch.zeros(3), 5, 0.05)[-1])
+
+
+def test_stage_start_offers_a_state_and_after_runs_after_the_step():
+    x = torch.nn.Parameter(torch.zeros(1))
+    seen = []
+
+    def step(k):
+        return Step((x - 1.0).pow(2).sum(), after=lambda: seen.append(float(x.detach())))
+
+    out = train([x], [Stage("s", 0, step, start=lambda: torch.tensor([7.0])),
+                      Stage("t", 3, step)], lr=0.1)
+    assert float(out.best) == 7.0
+    assert len(seen) == 3 and seen[0] > 0      # x had already moved when `after` ran
+
+
+def test_cosine_schedule_and_clipping_match_torch():
+    def run(opt_fn, **kw):
+        torch.manual_seed(0)
+        x = torch.nn.Parameter(torch.randn(4) * 10)
+        if opt_fn is None:
+            train([x], [Stage("s", 20, lambda k: Step(((x - 1) ** 4).sum()))], lr=0.3, **kw)
+        else:
+            opt_fn(x)
+        return x.detach()
+
+    def reference(x):
+        opt = torch.optim.Adam([x], lr=0.3)
+        sched = torch.optim.lr_scheduler.CosineAnnealingLR(opt, 20, eta_min=0.01)
+        for _ in range(20):
+            opt.zero_grad()
+            ((x - 1) ** 4).sum().backward()
+            torch.nn.utils.clip_grad_norm_([x], 2.0)
+            opt.step()
+            sched.step()
+
+    assert torch.equal(run(None, schedule="cosine", lr_min=0.01, grad_clip=2.0), run(reference))
+    with pytest.raises(ValueError, match="schedule"):
+        train([], [], lr=0.1, schedule="step")
+
+
+def test_progress_bar_runs_and_other_errors_propagate():
+    x = torch.nn.Parameter(torch.zeros(1))
+
+    def bad(k):
+        raise FloatingPointError("boom")
+
+    out = train([x], [Stage("s", 3, lambda k: Step(x.pow(2).sum(), {"v": float("nan")}))],
+                lr=0.1, progress=True)
+    assert out.steps == {"s": 3}
+    with pytest.raises(FloatingPointError):
+        train([x], [Stage("s", 3, bad)], lr=0.1, progress=True)
+
+
+def test_seeded_streams_are_reproducible():
+    g1, r1 = seeded(5)
+    a = (torch.rand(3, generator=g1), r1.random(3), torch.rand(2))
+    g2, r2 = seeded(5)
+    b = (torch.rand(3, generator=g2), r2.random(3), torch.rand(2))
+    assert torch.equal(a[0], b[0]) and np.array_equal(a[1], b[1]) and torch.equal(a[2], b[2])
+
+
+@pytest.mark.parametrize("device", ["tpu", 3.5, "cuda:0" if not torch.cuda.is_available()
+                                    else "meta"])
+def test_torch_device_rejects_what_is_not_here(device):
+    with pytest.raises(ValueError, match="device"):
+        torch_device(device)
+    assert torch_device("cpu").type == "cpu"
