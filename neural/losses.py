@@ -2,8 +2,9 @@
 
 Each term is the Monte-Carlo mean of its integrand over the matching sample
 set (Sec. 5.1): alignment and data on stroke samples, smoothness and Eikonal on
-iso-surface samples, curl on volume samples. Weights are named arguments of
-:class:`LossWeights` with the paper's values.
+iso-surface samples, curl on volume samples. The terms are unweighted; their
+weights (paper: 1, 0.01, 30, 7, 7) are the ``w_*`` fields of
+:class:`neural.presets.FlowConfig`, applied by :mod:`neural.flow`.
 
 References
 ----------
@@ -13,25 +14,12 @@ the Eikonal term of Sec. 4.3, 12 (curl), 13 (weights).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import torch
 
 from .geometry import alignment_cos4, covariant_tv, curl, second_fundamental_form, tangent_frame
 
-__all__ = ["LossWeights", "alignment_loss", "smoothness_loss", "smoothness_loss_autograd",
-           "data_loss", "eikonal_loss", "curl_loss"]
-
-
-@dataclass(frozen=True)
-class LossWeights:
-    """Weights of Eq. 13 (Sec. 4.4.3: 1, 0.01, 30, 7, 7 "for all the results in the paper")."""
-
-    w_align: float = 1.0
-    w_smooth: float = 0.01
-    w_data: float = 30.0
-    w_eik: float = 7.0
-    w_curl: float = 7.0
+__all__ = ["alignment_loss", "smoothness_loss", "smoothness_loss_autograd", "data_loss",
+           "eikonal_loss", "curl_loss"]
 
 
 def alignment_loss(g, G, tangents):
