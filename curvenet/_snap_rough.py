@@ -14,6 +14,10 @@ from .network import CurveNetwork
 
 __all__ = ["UnionFind", "dedup", "snap_rough"]
 
+#: Bound on the stroke samples of one snap: the sample spacing grows past tol / 4 to keep
+#: the total length / spacing under it.
+_MAX_SAMPLES = 2_000_000
+
 
 # --------------------------------------------------------------------------- small tools
 class UnionFind:
@@ -159,9 +163,9 @@ def _sample(st, h):
 
     Returns
     -------
-    (Q, sid, ss, tan, start) : points (M, 3), stroke id (M,), arc parameter (M,),
-        unit tangent (M, 3), and ``start (S + 1,)`` with stroke k's samples at
-        ``start[k]:start[k + 1]``.
+    (Q, sid, ss, tan, start, flat) : points (M, 3), stroke id (M,), arc parameter (M,),
+        unit tangent (M, 3), ``start (S + 1,)`` with stroke k's samples at
+        ``start[k]:start[k + 1]``, and the :class:`_Flat` arc-length table of the strokes.
     """
     flat = _Flat(st)
     n = np.maximum(2, np.ceil(flat.L / h).astype(np.int64) + 1)
@@ -778,5 +782,3 @@ def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
     net.report = report
     return net
 
-
-_MAX_SAMPLES = 2_000_000

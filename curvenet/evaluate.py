@@ -1,7 +1,7 @@
 """Mesh quality metrics: Chamfer, Hausdorff, normal error, F-score; stroke-to-surface distance.
 
 The metrics follow the SharpNet paper (Niu et al. 2025, Sec. 5, "Metrics"), with one
-deliberate change required by the project (DESIGN.md, ``curvenet eval``): distances are
+deliberate change (the project's ``curvenet eval``): distances are
 measured from points sampled on one mesh to the *other mesh's triangles*, not to the
 other mesh's sample points, so the sampling density sets no floor on the scores (with
 100k point-to-point samples a perfect unit sphere would already score a Chamfer distance

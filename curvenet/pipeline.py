@@ -41,8 +41,8 @@ class SurfaceResult:
     mesh : trimesh.Trimesh
         The surface, in the sketch's coordinates.
     method : str
-        ``"classical"``, ``"soapfilm"`` or ``"neural"`` (plus ``"+refine"`` /
-        ``"+creases"`` suffixes when those stages ran).
+        ``"classical"``, ``"soapfilm"`` or ``"neural"``; with ``refine``, the
+        classical name plus ``"+refine"`` (e.g. ``"classical+refine"``).
     sketch : Sketch or None
     network : CurveNetwork or None
     patchset : PatchSet or None

@@ -86,7 +86,6 @@ _COUNTERS = ("crossings", "t_junctions", "gap_merges", "closed_strokes", "trimme
              "strokes_dropped_short", "strokes_trimmed_away")
 
 _EXACT_EPS = 1e-9   # coincidence tolerance of exact mode, fraction of the diagonal
-_MAX_SAMPLES = 2_000_000
 
 
 @dataclass(frozen=True)

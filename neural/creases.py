@@ -622,7 +622,7 @@ def _refit_step(net, cfg: CreaseConfig, pools, gen):
         ps, gs_ = _phi(net, cfg.n_freqs, pool_s, i_s)
         pn, gn = _phi(net, cfg.n_freqs, pool_near, i_n)
         l_sdf = (pn - pools["near_target"][i_n]).abs().mean()
-        pa, ga = _phi(net, cfg.n_freqs, pool_a, i_a)
+        pa, _ = _phi(net, cfg.n_freqs, pool_a, i_a)
         l_sur = ps.abs().mean()
         if nk:
             i_k = torch.randint(0, len(pool_k[0]), (nk,), generator=gen).to(dev)

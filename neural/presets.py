@@ -156,6 +156,17 @@ _CHOICES = {"boundary": ("periodic", "dirichlet"), "surface_sampler": ("cells", 
             "smooth_mode": ("jet", "autograd"), "dtype": ("float32", "float64")}
 
 
+def _from_preset(presets: dict, quality: str, overrides: dict, what: str):
+    """``presets[quality]`` with the fields ``overrides`` replaced (names checked, not values)."""
+    if quality not in presets:
+        raise ValueError(f"quality must be one of {sorted(presets)}, got {quality!r}")
+    names = {f.name for f in fields(presets[quality])}
+    unknown = sorted(set(overrides) - names)
+    if unknown:
+        raise ValueError(f"unknown {what} setting(s) {unknown}; valid: {sorted(names)}")
+    return replace(presets[quality], **overrides)
+
+
 def get_config(quality: str = "draft", **overrides) -> FlowConfig:
     """The preset ``quality`` with ``overrides`` applied and validated.
 
@@ -179,13 +190,7 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
     >>> get_config("draft", res=96).res
     96
     """
-    if quality not in PRESETS:
-        raise ValueError(f"quality must be one of {sorted(PRESETS)}, got {quality!r}")
-    names = {f.name for f in fields(FlowConfig)}
-    unknown = sorted(set(overrides) - names)
-    if unknown:
-        raise ValueError(f"unknown neural setting(s) {unknown}; valid: {sorted(names)}")
-    cfg = replace(PRESETS[quality], **overrides)
+    cfg = _from_preset(PRESETS, quality, overrides, "neural")
     positive_int = ("res", "width", "n_stroke", "n_surface", "n_volume", "poisson_every")
     for name in positive_int:
         v = getattr(cfg, name)
@@ -357,14 +362,7 @@ def crease_config(quality: str = "draft", overrides: dict | None = None) -> Crea
     ValueError
         Unknown preset or field, or a value out of range.
     """
-    overrides = overrides or {}
-    if quality not in CREASE_PRESETS:
-        raise ValueError(f"quality must be one of {sorted(CREASE_PRESETS)}, got {quality!r}")
-    names = {f.name for f in fields(CreaseConfig)}
-    bad = sorted(set(overrides) - names)
-    if bad:
-        raise ValueError(f"unknown crease_refine setting(s) {bad}; known: {sorted(names)}")
-    cfg = replace(CREASE_PRESETS[quality], **overrides)
+    cfg = _from_preset(CREASE_PRESETS, quality, overrides or {}, "crease_refine")
     if cfg.activation not in ("softplus", "sine"):
         raise ValueError(f"activation must be 'softplus' or 'sine', got {cfg.activation!r}")
     for k in ("steps", "batch", "res", "pool", "hidden", "layers"):

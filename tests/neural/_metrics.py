@@ -1,4 +1,4 @@
-"""Mesh-to-mesh metrics for the neural tests and benchmark (DESIGN.md, `curvenet eval`).
+"""Mesh-to-mesh metrics for the neural tests and benchmark (as `curvenet eval`).
 
 Points are sampled uniformly by area on each mesh and their distances are taken
 to the *surface* of the other mesh (libigl), after scaling so the reference's
