@@ -159,7 +159,9 @@ def train(params, stages, *, lr: float, grad_clip: float = 0.0, schedule: str = 
     lr_min : float
         Final learning rate of the cosine schedule.
     progress : bool
-        Show a tqdm bar over all steps with the stage and the step's log.
+        Show a bar over all steps with the stage and the step's log
+        (:func:`curvenet.core.progress.progress_bar`: tqdm on a terminal, plain lines
+        elsewhere).
     desc : str
         Label of the bar.
     keep : callable
@@ -190,8 +192,8 @@ def train(params, stages, *, lr: float, grad_clip: float = 0.0, schedule: str = 
     out = Training(None, False, {s.name: 0 for s in stages}, {s.name: 0.0 for s in stages}, {})
     bar = None
     if progress:
-        from tqdm.auto import tqdm
-        bar = tqdm(total=total, desc=desc, unit="step", leave=False)
+        from curvenet.core.progress import progress_bar
+        bar = progress_bar(total, desc=desc, unit="step")
     try:
         for stage in stages:
             t0 = time.perf_counter()
