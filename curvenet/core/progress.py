@@ -59,8 +59,8 @@ class PlainProgress:
         if self.total > 0 and self.n / self.total >= self._next:
             self._line()
 
-    def set_postfix(self, ordered_dict=None, **kwargs) -> None:
-        items = {**(ordered_dict or {}), **kwargs}
+    def set_postfix(self, ordered_dict=None, refresh: bool = True, **kwargs) -> None:
+        items = {**(ordered_dict or {}), **kwargs}      # refresh: tqdm's, no effect here
         self.postfix = ", ".join(f"{k}={v}" for k, v in items.items())
 
     def close(self) -> None:

@@ -104,15 +104,18 @@ def test_cosine_schedule_and_clipping_match_torch():
         train([], [], lr=0.1, schedule="step")
 
 
-def test_progress_bar_runs_and_other_errors_propagate():
+def test_progress_bar_runs_and_other_errors_propagate(capsys):
     x = torch.nn.Parameter(torch.zeros(1))
 
     def bad(k):
         raise FloatingPointError("boom")
 
-    out = train([x], [Stage("s", 3, lambda k: Step(x.pow(2).sum(), {"v": float("nan")}))],
-                lr=0.1, progress=True)
+    out = train([x], [Stage("s", 3, lambda k: Step(x.pow(2).sum(), {"v": float("nan"),
+                                                                      "w": 2.0}))],
+                lr=0.1, progress=True, desc="quad")
     assert out.steps == {"s": 3}
+    err = capsys.readouterr().err        # not a terminal: plain lines
+    assert "quad: 3/3 step (stage=s, w=2)" in err and "refresh" not in err and "v=" not in err
     with pytest.raises(FloatingPointError):
         train([x], [Stage("s", 3, bad)], lr=0.1, progress=True)
 
