@@ -62,7 +62,7 @@ class BatchOptions:
     """Settings of every file's surfacing (the arguments of :func:`curvenet.pipeline.surface`).
 
     ``format`` is the output mesh format; ``neural_options`` a tuple of ``(name, value)``
-    pairs. Two batches with equal options give equal outputs for equal inputs; their hash
+    pairs; ``points`` forces the point-sample reading (``--points``). Two batches with equal options give equal outputs for equal inputs; their hash
     (:meth:`digest`) is recorded in the manifest.
     """
 
@@ -79,6 +79,7 @@ class BatchOptions:
     seed: int = 0
     neural_options: tuple = ()
     format: str = "obj"
+    points: bool = False
 
     def digest(self) -> str:
         """SHA-256 of the settings (hex)."""
@@ -170,7 +171,8 @@ def _surface_file(local: str, options: BatchOptions, tmp: str, *, preview, tile,
                   resolution=options.resolution, crease_angle=options.crease_angle,
                   refine=options.refine, quality=options.quality, device=options.device,
                   seed=options.seed, progress=False,
-                  neural_options=dict(options.neural_options) or None)
+                  neural_options=dict(options.neural_options) or None,
+                  points=True if options.points else "auto")
     out: dict = {f"t_{k}": float(v) for k, v in res.timings.items()}
     t = time.perf_counter()
     fid = stroke_fidelity(res.mesh, res.sketch if res.sketch is not None else res.network)

@@ -66,6 +66,14 @@ class _Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
+_POINTS_HELP = ("read every block of points as unordered samples of curves and recover the "
+                "curves (default: detected block by block)")
+
+
+def _points(args):
+    return True if args.points else "auto"
+
+
 def build_parser() -> argparse.ArgumentParser:
     p = _Parser(prog="curvenet", description="3D sketches and curve networks to surfaces.")
     p.add_argument("--debug", action="store_true", help="show tracebacks on errors")
@@ -75,6 +83,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("input")
     s.add_argument("-o", "--output", required=True, help="NETWORK.json (or .obj polylines)")
     s.add_argument("--snap-tol", type=_fraction, help="fraction of the bbox diagonal")
+    s.add_argument("--points", action="store_true", help=_POINTS_HELP)
 
     s = sub.add_parser("patches", help="find surface patches (PATCHES.json)")
     s.add_argument("input", help="sketch file or NETWORK.json")
@@ -82,6 +91,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--snap-tol", type=_fraction)
     s.add_argument("--close", choices=("auto", "none"), default="auto",
                    help="accept solid-closing patches automatically (default auto)")
+    s.add_argument("--points", action="store_true", help=_POINTS_HELP)
     s.add_argument("--interactive", action="store_true",
                    help="review patches: delete, accept/reject suggestions, undo, save")
     s.add_argument("--preview", metavar="PNG", help="write a picture of the patches")
@@ -109,6 +119,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--patches", metavar="PATCHES.json", help="use this (edited) patch set")
     s.add_argument("--snap-tol", type=_fraction)
     s.add_argument("--close", choices=("auto", "none"), default="auto")
+    s.add_argument("--points", action="store_true", help=_POINTS_HELP)
     s.add_argument("--surfacer", choices=("catmull-clark", "soapfilm"), default="catmull-clark")
     s.add_argument("--subdiv", type=_positive_int, help="Catmull-Clark levels")
     s.add_argument("--resolution", type=_positive_int, help="Coons samples per side segment")
@@ -152,7 +163,7 @@ def _cmd_snap(args) -> int:
     from .patchset import save_network
     from .snap import snap
     check_output_path(args.output, inputs=[args.input], what="-o")
-    sketch = read_sketch(args.input)
+    sketch = read_sketch(args.input, points=_points(args))
     net = snap(sketch, **({} if args.snap_tol is None else {"snap_tol": args.snap_tol}))
     if net.number_of_edges == 0:
         raise CurvenetError(f"{args.input}: snapping left no curves (every stroke collapsed "
@@ -164,6 +175,8 @@ def _cmd_snap(args) -> int:
     rep = ", ".join(f"{k} {v}" for k, v in net.report.items() if isinstance(v, (int, float)))
     print(f"{args.output}: {net.number_of_vertices} vertices, {net.number_of_edges} curves"
           + (f" ({rep})" if rep else ""))
+    if sketch.metadata.get("point_blocks"):
+        print(f"reading: {sketch.metadata['reading']}")
     return 0
 
 
@@ -173,7 +186,7 @@ def _cmd_patches(args) -> int:
     check_output_path(args.output, inputs=[args.input], what="-o")
     if args.preview:
         check_output_path(args.preview, inputs=[args.input, args.output], what="--preview")
-    ps = patches(args.input, snap_tol=args.snap_tol, close=args.close)
+    ps = patches(args.input, snap_tol=args.snap_tol, close=args.close, points=_points(args))
     if args.interactive:
         from .session import run_interactive
         ps = run_interactive(ps, input=sys.stdin, output=sys.stdout, preview=args.preview)
@@ -208,7 +221,7 @@ def _surface_one(inp: str, out: str, args) -> dict:
                       resolution=args.resolution, crease_angle=args.crease_angle,
                       refine=args.refine, quality=args.quality, device=args.device,
                       seed=args.seed, progress=not args.no_progress,
-                      neural_options=_neural_options(args))
+                      neural_options=_neural_options(args), points=_points(args))
         res.save(out)
         if args.preview:
             from .preview import render_preview
@@ -217,7 +230,8 @@ def _surface_one(inp: str, out: str, args) -> dict:
                            title=f"{Path(inp).name}: {res.method}", up=args.up)
         return {"input": inp, "output": out, "status": "ok", "method": res.method,
                 "faces": len(res.mesh.faces), "seconds": time.perf_counter() - t0,
-                "why": res.diagnostics.get("decision", ""), "interrupted": res.interrupted}
+                "why": res.diagnostics.get("decision", ""), "interrupted": res.interrupted,
+                "reading": res.diagnostics.get("reading", "")}
     except CurvenetError as err:
         return {"input": inp, "output": out, "status": "error", "error": _naming(err, inp),
                 "seconds": time.perf_counter() - t0}
@@ -248,6 +262,8 @@ def _cmd_surface(args) -> int:
     print(f"{row['output']}: {row['faces']} faces, {row['method']}, "
           f"{row['seconds']:.1f} s{partial}")
     if args.explain:
+        if row.get("reading"):
+            print(f"reading: {row['reading']}")
         print(f"route: {row['why']}")
     return 130 if row["interrupted"] else 0
 
@@ -259,7 +275,7 @@ def _batch_options(args):
                         crease_angle=args.crease_angle, refine=args.refine,
                         quality=args.quality, device=args.device, seed=args.seed,
                         neural_options=tuple(sorted((_neural_options(args) or {}).items())),
-                        format=args.format)
+                        format=args.format, points=args.points)
 
 
 def _progress(total: int, quiet: bool):

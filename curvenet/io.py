@@ -540,7 +540,7 @@ def detect_format(path, text: str | None = None) -> str:
 
 
 def read_sketch(path, *, format: str | None = None, strict: bool = False,
-                max_bytes: int = MAX_FILE_BYTES) -> Sketch:
+                max_bytes: int = MAX_FILE_BYTES, points="auto") -> Sketch:
     """Read a sketch file.
 
     Parameters
@@ -553,11 +553,17 @@ def read_sketch(path, *, format: str | None = None, strict: bool = False,
         Raise on a stroke with fewer than two points instead of dropping it.
     max_bytes : int
         Refuse larger files (default :data:`MAX_FILE_BYTES`, 1 GiB).
+    points : {"auto", True, False}
+        Blocks of unordered point samples (consecutive points far apart):
+        ``auto`` detects them block by block and recovers the curves they
+        sample, ``True`` reads every block so, ``False`` never (see
+        :func:`curvenet.pointcurves.read_point_blocks`).
 
     Returns
     -------
     Sketch
-        Strokes ``(n_i, 3) float64`` in file order, labels, ``source = str(path)``.
+        Strokes ``(n_i, 3) float64`` in file order, labels, ``source = str(path)``;
+        where blocks were read as point samples, ``metadata["reading"]`` says so and why.
 
     Raises
     ------
@@ -584,10 +590,13 @@ def read_sketch(path, *, format: str | None = None, strict: bool = False,
     text = _load_text(path, max_bytes)
     fmt = format or detect_format(path, text)
     if fmt == "obj":
-        return _read_obj(text, path, strict)
-    if fmt == "json":
-        return _read_json(text, path, strict)
-    return _read_blocks(text, path, strict, fmt)
+        sketch = _read_obj(text, path, strict)
+    elif fmt == "json":
+        sketch = _read_json(text, path, strict)
+    else:
+        sketch = _read_blocks(text, path, strict, fmt)
+    from .pointcurves import read_point_blocks
+    return read_point_blocks(sketch, points)
 
 
 def _fmt_points(arr) -> list:

@@ -92,15 +92,22 @@ def _is_network_json(path: Path) -> bool:
     return b'"curvenet.network"' in head or b'"curvenet.patches"' in head
 
 
-def load_source(source):
+def load_source(source, *, points="auto"):
     """Turn what the user gave into ``(sketch, patchset)``; one of them may be None.
 
     Parameters
     ----------
     source : Sketch, CurveNetwork, PatchSet, str or os.PathLike
         A sketch, or a file: any sketch format, ``NETWORK.json`` or ``PATCHES.json``.
+    points : {"auto", True, False}
+        Reading of unordered point samples in a sketch file (see
+        :func:`curvenet.io.read_sketch`); ``True`` also recovers the curves of
+        every stroke of a :class:`Sketch` given directly.
     """
     if isinstance(source, Sketch):
+        if points is True:
+            from .pointcurves import read_point_blocks
+            return read_point_blocks(source, True), None
         return source, None
     if isinstance(source, PatchSet):
         return None, source
@@ -112,7 +119,7 @@ def load_source(source):
     if _is_network_json(path):
         return None, load_network_file(path)
     from .io import read_sketch
-    return read_sketch(path), None
+    return read_sketch(path, points=points), None
 
 
 def _network(sketch, patchset, *, snap_tol, timings):
@@ -123,10 +130,12 @@ def _network(sketch, patchset, *, snap_tol, timings):
     kwargs = {} if snap_tol is None else {"snap_tol": snap_tol}
     net = snap(sketch, **kwargs)
     timings["snap"] = time.perf_counter() - t
+    if "reading" in sketch.metadata:
+        net.report["reading"] = sketch.metadata["reading"]
     return net
 
 
-def patches(source, *, snap_tol: float | None = None, close: str = "auto",
+def patches(source, *, snap_tol: float | None = None, close: str = "auto", points="auto",
             **options) -> PatchSet:
     """Snap (when given a sketch) and find patches.
 
@@ -139,6 +148,8 @@ def patches(source, *, snap_tol: float | None = None, close: str = "auto",
         Snapping tolerance as a fraction of the bounding-box diagonal.
     close : {"auto", "none"}
         Accept closing patches automatically (see :func:`curvenet.cycles.find_patches`).
+    points : {"auto", True, False}
+        Reading of unordered point samples (see :func:`load_source`).
     **options
         Passed to :func:`curvenet.cycles.find_patches`.
 
@@ -155,7 +166,7 @@ def patches(source, *, snap_tol: float | None = None, close: str = "auto",
     6
     """
     from .cycles import find_patches
-    sketch, given = load_source(source)
+    sketch, given = load_source(source, points=points)
     timings: dict = {}
     net = _network(sketch, given, snap_tol=snap_tol, timings=timings)
     t = time.perf_counter()
@@ -261,7 +272,7 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
             device: str = "cpu", seed: int = 0, progress: bool = False,
             classical_options: dict | None = None,
             neural_options: dict | None = None,
-            crease_options: dict | None = None) -> SurfaceResult:
+            crease_options: dict | None = None, points="auto") -> SurfaceResult:
     """Sketch (or network, or patch set) to surface.
 
     Parameters
@@ -302,6 +313,9 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
         Settings of the crease refit (:class:`neural.creases.CreaseConfig`, e.g.
         ``{"use_features": False}``), used when the neural route meets strokes labelled
         ``crease``; checked before any fit.
+    points : {"auto", True, False}
+        Reading of unordered point samples (see :func:`load_source`); the
+        reading taken is in ``diagnostics["reading"]``.
 
     Returns
     -------
@@ -338,7 +352,11 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
             raise InvalidParameterError(f"crease_options: {err}") from err
     timings: dict = {}
     diag: dict = {}
-    sketch, given = load_source(source)
+    sketch, given = load_source(source, points=points)
+    if sketch is not None:
+        diag["reading"] = sketch.metadata.get("reading", "polylines: no stroke is a block of "
+                                              "unordered points" if points is not False else
+                                              "polylines: point reading off")
     if patchset is not None:
         given = patchset
         if sketch is not None:
