@@ -62,7 +62,8 @@ class BatchOptions:
     """Settings of every file's surfacing (the arguments of :func:`curvenet.pipeline.surface`).
 
     ``format`` is the output mesh format; ``neural_options`` a tuple of ``(name, value)``
-    pairs; ``points`` forces the point-sample reading (``--points``). Two batches with equal options give equal outputs for equal inputs; their hash
+    pairs; ``points`` forces the point-sample reading (``--points``). Two batches with equal
+    options give equal outputs for equal inputs; their hash
     (:meth:`digest`) is recorded in the manifest.
     """
 
