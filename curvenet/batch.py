@@ -34,6 +34,7 @@ import dataclasses
 import hashlib
 import json
 import os
+import sys
 import tempfile
 import time
 from dataclasses import dataclass, field
@@ -188,6 +189,7 @@ def _surface_file(local: str, options: BatchOptions, tmp: str, *, preview, tile,
                mesh_bytes=data.encode() if isinstance(data, str) else bytes(data))
     name = Path(local).name
     strokes = res.sketch if res.sketch is not None else None
+    t = time.perf_counter()
     if preview:
         from .preview import render_preview
         png = Path(tmp, "preview.png")
@@ -200,15 +202,18 @@ def _surface_file(local: str, options: BatchOptions, tmp: str, *, preview, tile,
         render_preview(png, mesh=res.mesh, network=res.network, view=(20.0, -60.0),
                        size=TILE_SIZE, up=up)
         out["tile_png"] = png.read_bytes()
+    if preview or tile:
+        out["t_preview"] = time.perf_counter() - t
     return out
 
 
 def _worker_name() -> str:
-    try:
-        from distributed import get_worker
-        return get_worker().address
-    except (ImportError, ValueError):
-        return f"pid {os.getpid()}"
+    """The Dask worker's address inside a Dask worker, else ``pid N``."""
+    distributed = sys.modules.get("distributed")  # not imported in local processes
+    if distributed is not None:
+        with contextlib.suppress(ValueError):
+            return distributed.get_worker().address
+    return f"pid {os.getpid()}"
 
 
 # --------------------------------------------------------------------------- executors

@@ -205,12 +205,40 @@ def test_dask_cluster_with_a_bad_file_and_a_killed_worker_matches_jobs_2(tmp_pat
     rows = json.loads((tmp_path / "r.json").read_text())["rows"]
     assert [r["status"] for r in rows] == ["ok"] * len(inputs) + ["error"]
     assert "bad.obj" in rows[-1]["error"]
+    assert all(r["worker"].startswith("tcp://") for r in rows)  # ran on the cluster
     assert main(args + ["--out-dir", str(tmp_path / "local"), "--jobs", "2"]) == 2
     capsys.readouterr()
     for p in inputs:
         a = (tmp_path / "dask" / f"{p.stem}.ply").read_bytes()
         assert a == (tmp_path / "local" / f"{p.stem}.ply").read_bytes(), p.name
     assert not (tmp_path / "dask" / "bad.ply").exists()
+
+
+def test_a_task_whose_worker_dies_for_good_is_reported_and_the_rest_goes_on(tmp_path):
+    distributed = pytest.importorskip("distributed")
+    import dask
+    inputs = _shapes(tmp_path / "in") + _boxes(tmp_path / "in", 2)
+    with dask.config.set({"distributed.scheduler.allowed-failures": 0}), \
+            distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
+                                     dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
+        from curvenet.batch import DaskExecutor
+        victim = next(iter(client.run(os.getpid).values()))
+        killed = []
+
+        def on_row(row, done, total):  # the worker is on the next file by now: kill it
+            if not killed:
+                os.kill(victim, signal.SIGKILL)
+                killed.append(done)
+
+        res = run_batch(inputs, tmp_path / "out", BatchOptions(method="classical"),
+                        executor=DaskExecutor(client), on_row=on_row)
+    # the tasks on the dead worker (running or queued there) are lost; the others run
+    lost = [r for r in res.rows if r["status"] == "internal"]
+    assert 1 <= len(lost) <= len(inputs) - 2 and res.exit_code == 1
+    assert all("KilledWorker" in r["error"] for r in lost)
+    assert res.counts["ok"] == len(inputs) - len(lost)
+    assert all(os.path.isfile(r["output"]) for r in res.rows if r["status"] == "ok")
 
 
 # --------------------------------------------------------------------------- eval --pairs
