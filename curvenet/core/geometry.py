@@ -1,0 +1,328 @@
+"""Geometric primitives shared by the graph code and both backends.
+
+Polylines: validation, arc length, interpolation at arc-length parameters,
+resampling; triangle meshes: face normals and areas, area-uniform random
+sampling (trimesh's :func:`trimesh.sample.sample_surface`). Everything takes
+and returns numpy arrays; nothing here imports torch or another curvenet module
+(the neural backend converts the samples to tensors itself).
+
+Notes
+-----
+A polyline is an ``(n, d) float64`` array of ``n >= 2`` points (``d = 3`` for
+strokes and curves); its arc-length parameter at point ``i`` is the summed
+length of the segments before it. Every function is vectorised over points.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from curvenet.errors import InvalidParameterError
+
+from .tolerances import ZERO_LENGTH
+
+__all__ = [
+    "as_polyline",
+    "cumulative_length",
+    "arc_length",
+    "arc_length_params",
+    "interpolate_polyline",
+    "sample_at",
+    "resample_polyline",
+    "densify_polyline",
+    "face_normals_areas",
+    "sample_surface",
+]
+
+
+# --------------------------------------------------------------------------- polylines
+def as_polyline(points, *, name: str = "polyline", min_points: int = 2) -> np.ndarray:
+    """Validate and convert one polyline (a stroke, a curve, a boundary).
+
+    Parameters
+    ----------
+    points : array_like, (n, 3)
+        Finite points; an empty input counts as ``(0, 3)``.
+    name : str
+        Names the parameter in error messages (``"strokes[4]"``).
+    min_points : int
+        Fewest points accepted.
+
+    Returns
+    -------
+    (n, 3) float64 ndarray
+        A C-contiguous copy.
+
+    Raises
+    ------
+    InvalidParameterError
+        Not numbers, wrong shape, fewer than ``min_points`` points, or a NaN/inf
+        coordinate.
+
+    Examples
+    --------
+    >>> as_polyline([[0, 0, 0], [1, 0, 0]]).dtype
+    dtype('float64')
+    """
+    try:
+        arr = np.array(points, dtype=np.float64, copy=True)
+    except (TypeError, ValueError):
+        raise InvalidParameterError(f"{name}: points are not numbers") from None
+    if arr.size == 0:
+        arr = arr.reshape(0, 3)
+    if arr.ndim != 2 or arr.shape[1] != 3:
+        raise InvalidParameterError(f"{name}: expected an (n, 3) array, got shape {arr.shape}")
+    if arr.shape[0] < min_points:
+        raise InvalidParameterError(
+            f"{name}: needs at least {min_points} points, got {arr.shape[0]}")
+    if not np.isfinite(arr).all():
+        raise InvalidParameterError(f"{name}: contains NaN or infinite coordinates")
+    return np.ascontiguousarray(arr)
+
+
+def cumulative_length(polyline: np.ndarray) -> np.ndarray:
+    """Arc length from the first point to each point.
+
+    Parameters
+    ----------
+    polyline : (n, d) float64
+
+    Returns
+    -------
+    (n,) float64
+        ``0`` first, the total length last, non-decreasing.
+
+    Examples
+    --------
+    >>> cumulative_length(np.array([[0.0, 0], [3, 4], [3, 5]])).tolist()
+    [0.0, 5.0, 6.0]
+    """
+    p = np.asarray(polyline, dtype=np.float64)
+    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
+
+
+def arc_length(polyline: np.ndarray) -> float:
+    """Total length of a polyline (``cumulative_length(polyline)[-1]``).
+
+    Examples
+    --------
+    >>> arc_length(np.array([[0.0, 0, 0], [1, 0, 0], [1, 2, 0]]))
+    3.0
+    """
+    return float(cumulative_length(polyline)[-1])
+
+
+def arc_length_params(polyline: np.ndarray) -> np.ndarray:
+    """Normalised cumulative arc length of a polyline.
+
+    Parameters
+    ----------
+    polyline : (n, d) float64
+
+    Returns
+    -------
+    t : (n,) float64
+        ``t[0] = 0``, ``t[-1] = 1``, non-decreasing. A curve of length at most
+        :data:`~curvenet.core.tolerances.ZERO_LENGTH` gets uniform parameters
+        ``index / (n - 1)``.
+    """
+    cum = cumulative_length(polyline)
+    total = cum[-1]
+    if total <= ZERO_LENGTH:
+        return np.linspace(0.0, 1.0, len(cum))
+    return cum / total
+
+
+def interpolate_polyline(polyline: np.ndarray, s, *, cum=None,
+                         extrapolate: bool = False) -> np.ndarray:
+    """Points of a polyline at arc-length parameters ``s`` (linear interpolation).
+
+    Parameters
+    ----------
+    polyline : (n, d) float64, n >= 2
+    s : (k,) float64
+        Parameters in the units of ``cum``.
+    cum : (n,) float64, optional
+        Non-decreasing parameter of each point; default :func:`cumulative_length`.
+        Pass :func:`arc_length_params` for normalised parameters.
+    extrapolate : bool
+        Continue the first and last segments linearly past the ends; otherwise
+        ``s`` is clamped to ``[cum[0], cum[-1]]``.
+
+    Returns
+    -------
+    (k, d) float64
+
+    Notes
+    -----
+    A zero-length segment is never interpolated inside: ``s`` there equals its
+    start parameter and the result is its start point.
+
+    Examples
+    --------
+    >>> line = np.array([[0.0, 0, 0], [2, 0, 0]])
+    >>> interpolate_polyline(line, [0.5, 3.0])[:, 0].tolist()
+    [0.5, 2.0]
+    >>> interpolate_polyline(line, [3.0], extrapolate=True)[:, 0].tolist()
+    [3.0]
+    """
+    p = np.asarray(polyline, dtype=np.float64)
+    cum = cumulative_length(p) if cum is None else np.asarray(cum, dtype=np.float64)
+    s = np.asarray(s, dtype=np.float64)
+    if not extrapolate:
+        s = np.clip(s, cum[0], cum[-1])
+    j = np.clip(np.searchsorted(cum, s, side="right") - 1, 0, len(cum) - 2)
+    seg = cum[j + 1] - cum[j]
+    t = np.where(seg > 0, (s - cum[j]) / np.where(seg > 0, seg, 1.0), 0.0)
+    return p[j] + t[:, None] * (p[j + 1] - p[j])
+
+
+def sample_at(polyline: np.ndarray, t) -> np.ndarray:
+    """Points of a polyline at normalised arc-length parameters ``t`` in ``[0, 1]``.
+
+    Parameters
+    ----------
+    polyline : (n, d) float64
+    t : (k,) float64
+        Clamped to ``[0, 1]``; see :func:`arc_length_params` for a zero-length curve.
+
+    Returns
+    -------
+    (k, d) float64
+    """
+    return interpolate_polyline(polyline, t, cum=arc_length_params(polyline))
+
+
+def resample_polyline(polyline: np.ndarray, n_segments: int) -> np.ndarray:
+    """Resample a polyline into ``n_segments`` pieces of equal arc length.
+
+    Parameters
+    ----------
+    polyline : (n, d) float64
+    n_segments : int, >= 1
+
+    Returns
+    -------
+    (n_segments + 1, d) float64
+        First and last points are exactly ``polyline[0]`` and ``polyline[-1]``.
+
+    Examples
+    --------
+    >>> resample_polyline(np.array([[0.0, 0, 0], [1, 0, 0], [1, 1, 0]]), 4).tolist()[2]
+    [1.0, 0.0, 0.0]
+    """
+    p = np.asarray(polyline, dtype=np.float64)
+    out = sample_at(p, np.linspace(0.0, 1.0, int(n_segments) + 1))
+    out[0], out[-1] = p[0], p[-1]
+    return out
+
+
+def densify_polyline(polyline: np.ndarray, max_step: float) -> np.ndarray:
+    """Insert points so that consecutive points are at most ``max_step`` apart.
+
+    Every segment is split into ``ceil(length / max_step)`` equal pieces (at least
+    one); the original points are kept.
+
+    Parameters
+    ----------
+    polyline : (n, d) float64
+    max_step : float, > 0
+
+    Returns
+    -------
+    (m, d) float64
+        The input itself when ``n < 2``.
+
+    Examples
+    --------
+    >>> densify_polyline(np.array([[0.0, 0, 0], [1, 0, 0]]), 0.4)[:, 0].tolist()
+    [0.0, 0.3333333333333333, 0.6666666666666666, 1.0]
+    """
+    p = np.asarray(polyline, dtype=np.float64)
+    if len(p) < 2:
+        return p
+    seg = np.diff(p, axis=0)                                              # (n - 1, d)
+    steps = np.maximum(np.ceil(np.linalg.norm(seg, axis=1) / max_step).astype(np.int64), 1)
+    seg_id = np.repeat(np.arange(len(seg)), steps)
+    start = np.cumsum(steps) - steps
+    t = (np.arange(steps.sum()) - start[seg_id]) / steps[seg_id]          # 0, 1/k, ...
+    return np.concatenate([p[seg_id] + t[:, None] * seg[seg_id], p[-1:]])
+
+
+# --------------------------------------------------------------------------- triangles
+def face_normals_areas(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Unit normals and areas of triangles.
+
+    Parameters
+    ----------
+    vertices : (V, 3) float64
+    faces : (F, 3) int64
+
+    Returns
+    -------
+    normals : (F, 3) float64
+        Right-handed (counter-clockwise) unit normals; zero for a zero-area face.
+    areas : (F,) float64
+    """
+    tri = np.asarray(vertices, dtype=np.float64)[np.asarray(faces)]       # (F, 3, 3)
+    cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])        # (F, 3)
+    norm = np.linalg.norm(cross, axis=1)
+    normals = cross / np.maximum(norm, np.finfo(float).tiny)[:, None]    # guard: zero area
+    return normals, 0.5 * norm
+
+
+def sample_surface(vertices: np.ndarray, faces: np.ndarray, n: int, seed=None, *,
+                   areas=None) -> tuple[np.ndarray, np.ndarray]:
+    """Area-weighted uniform random points on a triangle mesh.
+
+    Parameters
+    ----------
+    vertices : (V, 3) float64
+    faces : (F, 3) int64
+    n : int
+        Number of points.
+    seed : int, numpy.random.Generator or None
+        A generator is used (and advanced) as given, so one stream can be threaded
+        through several calls; an int seeds a fresh one.
+    areas : (F,) float64, optional
+        Triangle areas if already known (any positive multiple works: they are
+        sampling weights).
+
+    Returns
+    -------
+    points : (n, 3) float64
+    face_index : (n,) int64
+        The triangle each point lies on.
+
+    Raises
+    ------
+    InvalidParameterError
+        No faces, or all of them of zero area.
+
+    Notes
+    -----
+    Delegates to :func:`trimesh.sample.sample_surface`: a triangle is drawn with
+    probability proportional to its area, then a point uniformly inside it by
+    folding a uniform point of the parallelogram spanned by two edges back into the
+    triangle.
+
+    Examples
+    --------
+    >>> tri = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+    >>> p, f = sample_surface(tri, np.array([[0, 1, 2]]), 100, seed=0)
+    >>> bool((p.sum(axis=1) <= 1).all()), f.max()
+    (True, np.int64(0))
+    """
+    import trimesh
+
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    if areas is None:
+        areas = face_normals_areas(v, f)[1]
+    areas = np.asarray(areas, dtype=np.float64)
+    if len(f) == 0 or not areas.sum() > 0:
+        raise InvalidParameterError("faces: no triangle of positive area to sample")
+    mesh = trimesh.Trimesh(vertices=v, faces=f, process=False, validate=False)
+    points, face_index = trimesh.sample.sample_surface(mesh, int(n), face_weight=areas,
+                                                       seed=seed)
+    return np.asarray(points, dtype=np.float64), np.asarray(face_index, dtype=np.int64)
