@@ -10,6 +10,7 @@ import numpy as np
 from scipy.ndimage import maximum_filter1d
 from scipy.spatial import cKDTree
 
+from .core.geometry import arc_length, cumulative_length, interpolate_polyline, resample_polyline
 from .network import CurveNetwork
 
 __all__ = ["UnionFind", "dedup", "snap_rough"]
@@ -76,20 +77,6 @@ def _clean(poly, eps):
     return poly[keep]
 
 
-def _arclength(poly):
-    """Cumulative arc length ``(n,)`` of an ``(n, 3)`` polyline."""
-    return np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(poly, axis=0), axis=1))])
-
-
-def _interp(poly, cum, s):
-    """Points ``(k, 3)`` at arc parameters ``s`` ``(k,)`` (clamped to the polyline)."""
-    s = np.clip(np.asarray(s, dtype=np.float64), 0.0, cum[-1])
-    j = np.clip(np.searchsorted(cum, s, side="right") - 1, 0, len(cum) - 2)
-    seg = cum[j + 1] - cum[j]
-    t = np.where(seg > 0, (s - cum[j]) / np.where(seg > 0, seg, 1.0), 0.0)
-    return poly[j] + t[:, None] * (poly[j + 1] - poly[j])
-
-
 def _bump(x):
     """C1 bump ``(1 - x^2)^2`` for ``|x| < 1``, else 0: value 1 and slope 0 at 0."""
     x = np.minimum(np.abs(x), 1.0)
@@ -101,11 +88,6 @@ def _smoothstep(x):
     return x * x * (3.0 - 2.0 * x)
 
 
-def _resample(curve, n):
-    cum = _arclength(curve)
-    return _interp(curve, cum, np.linspace(0.0, cum[-1], n))
-
-
 # --------------------------------------------------------------------------- state
 class _Strokes:
     """Working strokes: polylines, arc lengths, source ids and labels."""
@@ -115,13 +97,13 @@ class _Strokes:
 
     def add(self, poly, srcs, label, cum=None):
         self.polys.append(poly)
-        self.cums.append(_arclength(poly) if cum is None else cum)
+        self.cums.append(cumulative_length(poly) if cum is None else cum)
         self.srcs.append(tuple(sorted(set(srcs))))
         self.labels.append(label)
 
     def set(self, k, poly):
         self.polys[k] = poly
-        self.cums[k] = _arclength(poly)
+        self.cums[k] = cumulative_length(poly)
 
     def __len__(self):
         return len(self.polys)
@@ -287,7 +269,7 @@ def _consolidate(st, samples, con, tol, h, opts, report):
         for lo, hi, side in ((0.0, g0, "left"), (g1, gc[-1], "right")):
             if hi - lo <= 0.5 * h:
                 continue
-            pa = _interp(gp, gc, np.array([g0 if side == "left" else g1]))[0]
+            pa = interpolate_polyline(gp, np.array([g0 if side == "left" else g1]), cum=gc)[0]
             if tail_in and "tail" not in join and np.linalg.norm(hp[-1] - pa) <= 2.0 * tol:
                 join["tail"] = side
             elif head_in and "head" not in join and np.linalg.norm(hp[0] - pa) <= 2.0 * tol:
@@ -339,7 +321,7 @@ def _consolidate(st, samples, con, tol, h, opts, report):
 def _cut(poly, cum, a, b):
     """Sub-polyline ``(m, 3)`` between arc parameters ``a < b``, exact end points."""
     inner = (cum > a) & (cum < b)
-    ends = _interp(poly, cum, np.array([a, b]))
+    ends = interpolate_polyline(poly, np.array([a, b]), cum=cum)
     return np.vstack([ends[:1], poly[inner], ends[1:]])
 
 
@@ -565,7 +547,7 @@ def _displace_and_split(poly, cum, cuts, disp, tol, opts):
     R = np.minimum(opts.blend * tol, 0.45 * np.minimum(gaps[:-1], gaps[1:]))
     R = np.maximum(R, 1e-300)  # guard: coincident cuts are removed before this point
     s_all = np.concatenate([cum, cuts])
-    p_all = np.vstack([poly, _interp(poly, cum, cuts)])
+    p_all = np.vstack([poly, interpolate_polyline(poly, cuts, cum=cum)])
     is_cut = np.concatenate([np.zeros(len(cum), bool), np.ones(k, bool)])
     # drop polyline vertices closer than tol / 10 to a cut: no needle segments there
     near = np.zeros(len(cum), bool)
@@ -649,8 +631,8 @@ def _merge_slivers(edges, tol):
                 ex, ey = ids[x], ids[y]
                 if ex in dead or ey in dead:
                     continue
-                cx = _resample(edges[ex][2] if edges[ex][0] == u else edges[ex][2][::-1], 64)
-                cy = _resample(edges[ey][2] if edges[ey][0] == u else edges[ey][2][::-1], 64)
+                cx, cy = (resample_polyline(edges[k][2] if edges[k][0] == u else edges[k][2][::-1],
+                                            63) for k in (ex, ey))
                 if np.linalg.norm(cx - cy, axis=1).max() <= 2.0 * tol:
                     avg = 0.5 * (cx + cy)
                     e = edges[ex]
@@ -673,7 +655,7 @@ def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
               "strokes_dropped_short": 0, "warnings": []}
     st = _Strokes()
     for p, s, lab in zip(strokes, src, labels):
-        if _arclength(p)[-1] < opts.min_length * tol:
+        if arc_length(p) < opts.min_length * tol:
             report["strokes_dropped_short"] += 1
             continue
         st.add(p, (s,), lab)
@@ -707,7 +689,7 @@ def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
         for s in found:
             if all(abs(s - t) > 2.0 * tol for t in taken):
                 vid = len(verts)
-                verts.append(_interp(st.polys[k], st.cums[k], np.array([s]))[0])
+                verts.append(interpolate_polyline(st.polys[k], np.array([s]), cum=st.cums[k])[0])
                 corner_ids.add(vid)
                 per_stroke.setdefault(k, []).append((s, vid))
                 report["corners"] += 1
@@ -737,7 +719,7 @@ def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
         for q, piece in enumerate(pieces):
             if piece is None or len(piece) < 2:
                 continue
-            plen = _arclength(piece)[-1]
+            plen = arc_length(piece)
             free_head = q == 0
             free_tail = q == len(pieces) - 1
             if (free_head or free_tail) and ids:

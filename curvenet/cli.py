@@ -15,6 +15,7 @@ import time
 from pathlib import Path
 
 from ._atomic import check_output_path
+from .core.tolerances import check_snap_tol
 from .errors import CurvenetError, InvalidParameterError, OutputError
 
 __all__ = ["main", "build_parser"]
@@ -25,10 +26,10 @@ def _fraction(text: str) -> float:
         value = float(text)
     except ValueError:
         raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
-    if not (0.0 < value < 0.5):
-        raise argparse.ArgumentTypeError(
-            f"{text} is not a fraction of the bounding-box diagonal in (0, 0.5)")
-    return value
+    try:
+        return check_snap_tol(value)
+    except InvalidParameterError as err:
+        raise argparse.ArgumentTypeError(str(err)) from None
 
 
 def _neural_setting(text: str) -> tuple[str, object]:

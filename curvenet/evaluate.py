@@ -20,14 +20,12 @@ from pathlib import Path
 
 import numpy as np
 
+from .core.geometry import as_polyline, densify_polyline, face_normals_areas, sample_surface
+from .core.tolerances import DEGENERATE_AREA_REL
 from .errors import InvalidParameterError, SketchFormatError
 
 __all__ = ["evaluate_mesh", "stroke_distance", "stroke_fidelity", "format_report",
            "load_mesh_arrays", "sample_surface", "point_surface_distance"]
-
-#: Relative area below which a triangle counts as degenerate (times the squared bbox diagonal).
-#: Degenerate triangles have no normal and zero sampling probability; they are dropped.
-DEGENERATE_AREA_REL = 1e-14
 
 #: Stroke polylines are resampled with this spacing relative to the sketch's bbox diagonal.
 STROKE_SPACING_REL = 1e-3
@@ -113,18 +111,9 @@ def load_mesh_arrays(mesh, *, name: str = "mesh") -> tuple[np.ndarray, np.ndarra
     return np.ascontiguousarray(v), np.ascontiguousarray(f)
 
 
-def _face_geometry(vertices, faces):
-    """Unit face normals ``(m, 3)`` and areas ``(m,)``; zero normal for degenerate faces."""
-    tri = vertices[faces]  # (m, 3, 3)
-    cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])  # (m, 3)
-    norm = np.linalg.norm(cross, axis=1)
-    normals = cross / np.maximum(norm, np.finfo(float).tiny)[:, None]
-    return normals, 0.5 * norm
-
-
 def _drop_degenerate(vertices, faces):
     """Faces, unit normals and areas of the non-degenerate triangles only."""
-    normals, areas = _face_geometry(vertices, faces)
+    normals, areas = face_normals_areas(vertices, faces)
     diag2 = float(np.sum(np.ptp(vertices, axis=0) ** 2))
     keep = areas > DEGENERATE_AREA_REL * max(diag2, np.finfo(float).tiny)
     return faces[keep], normals[keep], areas[keep]
@@ -133,45 +122,6 @@ def _drop_degenerate(vertices, faces):
 # ---------------------------------------------------------------------------
 # core array functions
 # ---------------------------------------------------------------------------
-def sample_surface(vertices, faces, n: int, rng, *, areas=None) -> tuple[np.ndarray, np.ndarray]:
-    """Area-weighted uniform random points on a triangle mesh.
-
-    Parameters
-    ----------
-    vertices : (V, 3) float64
-    faces : (F, 3) int64
-    n : int
-        Number of points.
-    rng : numpy.random.Generator
-    areas : (F,) float64, optional
-        Triangle areas, if already known.
-
-    Returns
-    -------
-    points : (n, 3) float64
-    face_index : (n,) int64
-        The triangle each point lies on.
-
-    Notes
-    -----
-    A triangle is drawn with probability proportional to its area, then a point uniformly
-    inside it with the square-root barycentric map ``(1 - sqrt(u), sqrt(u)(1 - w),
-    sqrt(u) w)`` (Osada et al. 2002, Eq. 1).
-    """
-    tri = vertices[faces]  # (F, 3, 3)
-    if areas is None:
-        areas = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]),
-                                     axis=1)
-    cdf = np.cumsum(areas)
-    face_index = np.searchsorted(cdf, rng.random(n) * cdf[-1], side="right")
-    face_index = np.minimum(face_index, len(faces) - 1).astype(np.int64)
-    su = np.sqrt(rng.random(n))[:, None]  # (n, 1)
-    w = rng.random(n)[:, None]
-    t = tri[face_index]  # (n, 3, 3)
-    points = (1.0 - su) * t[:, 0] + su * (1.0 - w) * t[:, 1] + su * w * t[:, 2]
-    return points, face_index
-
-
 def point_surface_distance(points, vertices, faces) -> tuple[np.ndarray, np.ndarray]:
     """Unsigned distance from points to a triangle mesh's surface, and the closest triangle.
 
@@ -367,22 +317,6 @@ def _stroke_list(strokes) -> list:
             f"got {type(strokes).__name__}") from None
 
 
-def _resample_polylines(polylines, spacing):
-    """Points along each polyline at arc-length steps of at most ``spacing`` (ends kept)."""
-    out = []
-    for pl in polylines:
-        seg = pl[1:] - pl[:-1]  # (k, 3)
-        seglen = np.linalg.norm(seg, axis=1)
-        steps = np.maximum(np.ceil(seglen / spacing).astype(np.int64), 1)  # per segment
-        seg_id = np.repeat(np.arange(len(seg)), steps)
-        # parameter within each segment: 0, 1/steps, ..., (steps-1)/steps
-        start = np.cumsum(steps) - steps
-        t = (np.arange(steps.sum()) - start[seg_id]) / steps[seg_id]
-        out.append(pl[seg_id] + t[:, None] * seg[seg_id])
-        out.append(pl[-1:])
-    return np.concatenate(out)
-
-
 def stroke_distance(mesh, strokes, *, spacing: float = STROKE_SPACING_REL) -> dict:
     """How closely a surface passes through the sketch's strokes.
 
@@ -442,12 +376,10 @@ def _stroke_sample_distances(mesh, strokes, spacing):
     bounding-box diagonal (samples are ``spacing * diag`` apart), ``vertices`` (V, 3)
     float64 of the mesh.
     """
-    from .sketch import as_stroke
-
     if not (isinstance(spacing, (int, float, np.floating)) and math.isfinite(spacing)
             and spacing > 0):
         raise InvalidParameterError(f"spacing must be a positive number, got {spacing!r}")
-    lines = [as_stroke(s, name=f"strokes[{i}]") for i, s in enumerate(_stroke_list(strokes))]
+    lines = [as_polyline(s, name=f"strokes[{i}]") for i, s in enumerate(_stroke_list(strokes))]
     if not lines:
         raise InvalidParameterError("strokes: no strokes to measure")
     v, f = load_mesh_arrays(mesh, name="mesh")
@@ -457,7 +389,8 @@ def _stroke_sample_distances(mesh, strokes, spacing):
     f, _n, _a = _drop_degenerate(v, f)
     if len(f) == 0:
         raise InvalidParameterError("mesh: all triangles have zero area")
-    d, _ = point_surface_distance(_resample_polylines(lines, spacing * diag), v, f)
+    pts = np.concatenate([densify_polyline(pl, spacing * diag) for pl in lines])
+    d, _ = point_surface_distance(pts, v, f)
     return d, diag, v
 
 

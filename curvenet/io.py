@@ -52,9 +52,11 @@ from pathlib import Path
 import numpy as np
 
 from ._atomic import atomic_write_text
-from .errors import SketchFormatError
-from .network import CurveNetwork
-from .sketch import LABELS, Sketch
+from .core.geometry import as_polyline
+from .core.strokes import LABELS
+from .errors import InvalidParameterError, SketchFormatError
+from .network import CurveNetwork, indexed_network
+from .sketch import Sketch
 
 __all__ = ["FORMATS", "MAX_FILE_BYTES", "read_sketch", "write_sketch", "write_network_obj",
            "read_network_obj", "detect_format"]
@@ -473,20 +475,10 @@ def _read_json(text, path, strict):
         lab = s.get("label", "boundary") if isinstance(s, dict) else "boundary"
         if lab not in LABELS:
             raise SketchFormatError(f"strokes[{i}]: unknown label {lab!r}", path=path)
-        try:
-            arr = np.asarray(pts, dtype=np.float64)
-        except (TypeError, ValueError):
-            raise SketchFormatError(f"strokes[{i}]: points are not numbers", path=path) from None
-        except OverflowError:
-            raise SketchFormatError(f"strokes[{i}]: a coordinate is too large for a float",
-                                    path=path) from None
-        if arr.size == 0:
-            arr = arr.reshape(0, 3)
-        if arr.ndim != 2 or arr.shape[1] != 3:
-            raise SketchFormatError(f"strokes[{i}]: expected [[x, y, z], ...], got shape "
-                                    f"{arr.shape}", path=path)
-        if not np.isfinite(arr).all():
-            raise SketchFormatError(f"strokes[{i}]: NaN or infinite coordinate", path=path)
+        try:  # short strokes are dropped (or rejected) by _finish, naming the file
+            arr = as_polyline(pts, name=f"strokes[{i}]", min_points=0)
+        except InvalidParameterError as err:
+            raise SketchFormatError(str(err), path=path) from None
         strokes.append(arr)
         labels.append(lab)
         where.append(None)
@@ -723,52 +715,6 @@ def read_network_obj(path, *, max_bytes: int = MAX_FILE_BYTES) -> CurveNetwork:
     polys = [p for p in polys if len(p) >= 2]
     if not polys:
         raise SketchFormatError("no polylines with two or more points", path=path)
-    net = _indexed_network(verts, polys, labels, range(len(polys)))
+    net = indexed_network(verts, polys, labels, range(len(polys)))
     net.report = {"polylines": len(polys), "source": str(path)}
-    return net
-
-
-def _indexed_network(verts, polys, labels, sources) -> CurveNetwork:
-    """Exact graph of polylines given as index arrays into ``verts`` (no tolerance).
-
-    Vertices are the indices that end an open polyline, occur two or more times
-    (over all polylines, a closed polyline's repeated end counted once), or
-    where three or more segments meet; each closed polyline with none of those
-    gets a loop edge at its first point. ``sources[k]`` is stored in
-    ``edge.strokes`` of the pieces of polyline ``k``.
-    """
-    nv = len(verts)
-    use = np.zeros(nv, dtype=np.int64)
-    key = np.zeros(nv, dtype=bool)
-    seg_deg = np.zeros(nv, dtype=np.int64)
-    for p in polys:
-        closed = p[0] == p[-1] and len(p) > 2
-        body = p[:-1] if closed else p
-        np.add.at(use, body, 1)
-        np.add.at(seg_deg, p[:-1], 1)
-        np.add.at(seg_deg, p[1:], 1)
-        if not closed:
-            key[p[0]] = key[p[-1]] = True
-    key |= (use >= 2) | (seg_deg >= 3)
-    vid = -np.ones(nv, dtype=np.int64)
-    net_v = list(np.flatnonzero(key))
-    vid[net_v] = np.arange(len(net_v))
-    pieces = []
-    for k, p in enumerate(polys):
-        if p[0] == p[-1] and len(p) > 2:  # closed polyline
-            inner = np.flatnonzero(key[p[:-1]])
-            if inner.size == 0:  # nothing else on it: a loop edge at its first point
-                key[p[0]] = True
-                vid[p[0]] = len(net_v)
-                net_v.append(p[0])
-            else:  # rotate so that it starts (and ends) at its first vertex
-                r = inner[0]
-                p = np.concatenate([p[r:-1], p[:r + 1]])
-        cut = np.flatnonzero(key[p])
-        for a, b in zip(cut[:-1], cut[1:]):
-            pieces.append((p[a:b + 1], labels[k], k))
-    net = CurveNetwork(verts[np.asarray(net_v, dtype=np.int64)])
-    for idx, lab, k in pieces:
-        net.add_edge(int(vid[idx[0]]), int(vid[idx[-1]]), verts[idx], strokes=(int(sources[k]),),
-                     label="crease" if lab == "crease" else "boundary")
     return net

@@ -12,10 +12,11 @@ from dataclasses import dataclass, field
 import networkx as nx
 import numpy as np
 
-from .errors import NetworkError, SketchFormatError
-from .sketch import LABELS
+from .core.geometry import arc_length, as_polyline
+from .core.strokes import LABELS
+from .errors import InvalidParameterError, NetworkError, SketchFormatError
 
-__all__ = ["Edge", "CurveNetwork"]
+__all__ = ["Edge", "CurveNetwork", "indexed_network"]
 
 
 @dataclass
@@ -43,7 +44,7 @@ class Edge:
 
     def length(self) -> float:
         """Polyline length."""
-        return float(np.linalg.norm(np.diff(self.curve, axis=0), axis=1).sum())
+        return arc_length(self.curve)
 
 
 @dataclass
@@ -89,11 +90,11 @@ class CurveNetwork:
         n = len(self.positions)
         if not (0 <= u < n and 0 <= v < n):
             raise NetworkError(f"edge ({u}, {v}): vertex index out of range 0..{n - 1}")
-        c = np.array(curve, dtype=np.float64).reshape(-1, 3)
-        if len(c) < 2:
-            raise NetworkError(f"edge ({u}, {v}): a curve needs at least 2 points")
-        if not np.isfinite(c).all():
-            raise NetworkError(f"edge ({u}, {v}): curve has NaN or infinite coordinates")
+        try:
+            c = as_polyline(np.reshape(np.asarray(curve, dtype=np.float64), (-1, 3)),
+                            name=f"edge ({u}, {v}) curve")
+        except InvalidParameterError as err:
+            raise NetworkError(str(err)) from None
         if label not in LABELS:
             raise NetworkError(f"edge ({u}, {v}): unknown label {label!r}")
         c[0] = self.positions[u]
@@ -178,3 +179,75 @@ class CurveNetwork:
         except (KeyError, TypeError, ValueError) as err:
             raise SketchFormatError(f"not a curvenet network: {err!r}", path=path) from None
         return net
+
+
+def indexed_network(verts, polys, labels, sources) -> CurveNetwork:
+    """Exact graph of polylines given as index arrays into ``verts`` (no tolerance).
+
+    Parameters
+    ----------
+    verts : (n, 3) float64 ndarray
+        Point positions.
+    polys : list of (m_k,) int64 ndarray
+        Each polyline as indices into ``verts``, ``m_k >= 2``; a polyline whose first
+        and last index are equal (and ``m_k > 2``) is closed.
+    labels : list of str
+        Per polyline; ``"crease"`` stays a crease, anything else becomes ``"boundary"``.
+    sources : sequence of int
+        Per polyline, the stroke id stored in its pieces' ``edge.strokes``.
+
+    Returns
+    -------
+    CurveNetwork
+
+    Notes
+    -----
+    Vertices are the indices that end an open polyline, occur two or more times
+    (over all polylines, a closed polyline's repeated end counted once), or
+    where three or more segments meet; each closed polyline with none of those
+    gets a loop edge at its first point. Used by the OBJ network reader and by
+    exact-mode snapping.
+
+    Examples
+    --------
+    >>> verts = np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0], [1, 1, 0]])
+    >>> net = indexed_network(verts, [np.array([0, 1, 2]), np.array([1, 3])],
+    ...                       ["boundary", "crease"], [0, 1])
+    >>> net.number_of_vertices, net.number_of_edges
+    (4, 3)
+    """
+    nv = len(verts)
+    use = np.zeros(nv, dtype=np.int64)
+    key = np.zeros(nv, dtype=bool)
+    seg_deg = np.zeros(nv, dtype=np.int64)
+    for p in polys:
+        closed = p[0] == p[-1] and len(p) > 2
+        body = p[:-1] if closed else p
+        np.add.at(use, body, 1)
+        np.add.at(seg_deg, p[:-1], 1)
+        np.add.at(seg_deg, p[1:], 1)
+        if not closed:
+            key[p[0]] = key[p[-1]] = True
+    key |= (use >= 2) | (seg_deg >= 3)
+    vid = -np.ones(nv, dtype=np.int64)
+    net_v = list(np.flatnonzero(key))
+    vid[net_v] = np.arange(len(net_v))
+    pieces = []
+    for k, p in enumerate(polys):
+        if p[0] == p[-1] and len(p) > 2:  # closed polyline
+            inner = np.flatnonzero(key[p[:-1]])
+            if inner.size == 0:  # nothing else on it: a loop edge at its first point
+                key[p[0]] = True
+                vid[p[0]] = len(net_v)
+                net_v.append(p[0])
+            else:  # rotate so that it starts (and ends) at its first vertex
+                r = inner[0]
+                p = np.concatenate([p[r:-1], p[:r + 1]])
+        cut = np.flatnonzero(key[p])
+        for a, b in zip(cut[:-1], cut[1:]):
+            pieces.append((p[a:b + 1], labels[k], k))
+    net = CurveNetwork(verts[np.asarray(net_v, dtype=np.int64)])
+    for idx, lab, k in pieces:
+        net.add_edge(int(vid[idx[0]]), int(vid[idx[-1]]), verts[idx], strokes=(int(sources[k]),),
+                     label="crease" if lab == "crease" else "boundary")
+    return net

@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 
 from ._atomic import atomic_path
+from .core.geometry import as_polyline
 from .errors import InvalidParameterError
 
 __all__ = ["render_preview", "patch_polygons", "decimate_clustering", "DEFAULT_VIEWS",
@@ -218,9 +219,8 @@ def _strokes_with_colours(strokes):
     labels = None
     if hasattr(strokes, "strokes") and hasattr(strokes, "labels"):
         strokes, labels = strokes.strokes, strokes.labels
-    from .sketch import as_stroke
 
-    lines = [as_stroke(s, name=f"strokes[{i}]") for i, s in enumerate(strokes)]
+    lines = [as_polyline(s, name=f"strokes[{i}]") for i, s in enumerate(strokes)]
     labels = labels or ["boundary"] * len(lines)
     colours = [_CONSTRUCTION_COLOUR if lab == "construction" else _STROKE_COLOUR
                for lab in labels]

@@ -14,21 +14,12 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ._snap_rough import _arclength
+from .core.geometry import arc_length, interpolate_polyline, resample_polyline
 from .errors import InvalidParameterError
 from .network import CurveNetwork
 from .sketch import Sketch
 
 __all__ = ["rough_sketch", "match_networks"]
-
-
-def _at(c, cum, s):
-    """Points at arc parameters ``s``, extrapolating linearly past both ends."""
-    s = np.asarray(s, dtype=np.float64)
-    j = np.clip(np.searchsorted(cum, s, side="right") - 1, 0, len(cum) - 2)
-    seg = np.maximum(cum[j + 1] - cum[j], 1e-300)  # guard: repeated points
-    t = (s - cum[j]) / seg
-    return c[j] + t[:, None] * (c[j + 1] - c[j])
 
 
 def _wobble(rng, n, amplitude):
@@ -50,9 +41,8 @@ def _wobble(rng, n, amplitude):
 
 def _stroke(rng, curve, s0, s1, diag, wobble, spacing):
     """A wobbly stroke along arc parameters ``[s0, s1]`` of ``curve`` (may extrapolate)."""
-    cum = _arclength(curve)
     n = max(8, int(np.ceil(abs(s1 - s0) / spacing)) + 1)
-    pts = _at(curve, cum, np.linspace(s0, s1, n))
+    pts = interpolate_polyline(curve, np.linspace(s0, s1, n), extrapolate=True)
     return pts + _wobble(rng, n, wobble * diag * rng.uniform(0.5, 1.0))
 
 
@@ -112,7 +102,7 @@ def rough_sketch(network: CurveNetwork, *, seed: int, wobble: float = 0.003,
     strokes, labels = [], []
     for e in network.edges:
         c = e.curve
-        L = _arclength(c)[-1]
+        L = arc_length(c)
         spacing = L / max(samples - 1, 1)
         a = -rng.uniform(-overshoot, overshoot) * diag
         b = L + rng.uniform(-overshoot, overshoot) * diag
@@ -172,8 +162,7 @@ def match_networks(reference: CurveNetwork, result: CurveNetwork, *, tol: float 
     diag = reference.diagonal
 
     def res(c):
-        cum = _arclength(c)
-        return _at(c, cum, np.linspace(0.0, cum[-1], samples))
+        return resample_polyline(c, samples - 1)
 
     ref = [res(e.curve) for e in reference.edges]
     out = [res(e.curve) for e in result.edges]

@@ -12,41 +12,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .errors import InvalidParameterError
+from .core.strokes import LABELS, check_strokes
 
-__all__ = ["LABELS", "Sketch", "as_stroke"]
-
-LABELS = ("boundary", "crease", "construction")
-
-
-def as_stroke(points, *, name: str = "stroke") -> np.ndarray:
-    """Validate and convert one stroke.
-
-    Parameters
-    ----------
-    points : array_like, (n, 3)
-        Stroke points, ``n >= 2``, all finite.
-    name : str
-        Used in error messages.
-
-    Returns
-    -------
-    (n, 3) float64 ndarray
-        A C-contiguous copy.
-
-    Raises
-    ------
-    InvalidParameterError
-        Wrong shape, fewer than two points, or a NaN/inf coordinate.
-    """
-    arr = np.array(points, dtype=np.float64, copy=True)
-    if arr.ndim != 2 or arr.shape[1] != 3:
-        raise InvalidParameterError(f"{name}: expected an (n, 3) array, got shape {arr.shape}")
-    if arr.shape[0] < 2:
-        raise InvalidParameterError(f"{name}: a stroke needs at least 2 points, got {arr.shape[0]}")
-    if not np.isfinite(arr).all():
-        raise InvalidParameterError(f"{name}: contains NaN or infinite coordinates")
-    return np.ascontiguousarray(arr)
+__all__ = ["LABELS", "Sketch"]
 
 
 @dataclass
@@ -78,17 +46,7 @@ class Sketch:
     source: str | None = None
 
     def __post_init__(self):
-        self.strokes = [as_stroke(s, name=f"stroke {i}") for i, s in enumerate(self.strokes)]
-        if self.labels is None:
-            self.labels = ["boundary"] * len(self.strokes)
-        self.labels = [str(lab) for lab in self.labels]
-        if len(self.labels) != len(self.strokes):
-            raise InvalidParameterError(
-                f"labels: {len(self.labels)} labels for {len(self.strokes)} strokes")
-        for i, lab in enumerate(self.labels):
-            if lab not in LABELS:
-                raise InvalidParameterError(
-                    f"labels[{i}]: unknown label {lab!r}; use one of {LABELS}")
+        self.strokes, self.labels = check_strokes(self.strokes, self.labels)
 
     def __len__(self) -> int:
         return len(self.strokes)

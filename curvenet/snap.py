@@ -63,10 +63,10 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
+from .core.tolerances import COINCIDENT_REL, DUPLICATE_POINT_REL, check_snap_tol
 from .errors import InvalidParameterError
 from ._snap_rough import UnionFind, dedup
-from .io import _indexed_network
-from .network import CurveNetwork
+from .network import CurveNetwork, indexed_network
 from .sketch import Sketch
 
 __all__ = ["SnapOptions", "DEFAULT_SNAP_TOL", "snap", "prune_dangling", "dangling_vertices"]
@@ -84,8 +84,6 @@ DEFAULT_SNAP_TOL = 0.025
 _COUNTERS = ("crossings", "t_junctions", "gap_merges", "closed_strokes", "trimmed_overshoots",
              "overdraw_consolidations", "corners", "dissolved_joins", "slivers_merged",
              "strokes_dropped_short", "strokes_trimmed_away")
-
-_EXACT_EPS = 1e-9   # coincidence tolerance of exact mode, fraction of the diagonal
 
 
 @dataclass(frozen=True)
@@ -126,9 +124,7 @@ class SnapOptions:
 
     def validate(self) -> "SnapOptions":
         """Raise :class:`InvalidParameterError` naming any out-of-range option."""
-        if not (np.isfinite(self.snap_tol) and 0 < self.snap_tol <= 0.5):
-            raise InvalidParameterError(f"snap_tol must be in (0, 0.5] (a fraction of the "
-                                        f"bounding-box diagonal), got {self.snap_tol!r}")
+        check_snap_tol(self.snap_tol)
         if not 0 < self.corner_angle <= 180:
             raise InvalidParameterError(f"corner_angle must be in (0, 180] degrees, "
                                         f"got {self.corner_angle!r}")
@@ -161,7 +157,7 @@ def _prepare(sketch, opts):
     strokes, src, labels = [], [], []
     dropped = 0
     for i in use:
-        s = dedup(sketch.strokes[i], 1e-12 * diag)
+        s = dedup(sketch.strokes[i], DUPLICATE_POINT_REL * diag)
         if len(s) < 2:
             dropped += 1
             continue
@@ -178,7 +174,7 @@ def _is_exact(strokes, diag):
     sid = np.repeat(np.arange(len(strokes)), counts)
     last = np.cumsum(counts) - 1
     first = last - counts + 1
-    eps = _EXACT_EPS * diag
+    eps = COINCIDENT_REL * diag
     closed = np.linalg.norm(pts[first] - pts[last], axis=1) <= eps
     ends = np.concatenate([first, last])
     tree = cKDTree(pts)
@@ -198,7 +194,7 @@ def _is_exact(strokes, diag):
 def _snap_exact(strokes, src, labels, diag):
     """Graph of exactly coincident points (no tolerance); see module docstring."""
     pts = np.concatenate(strokes)
-    eps = _EXACT_EPS * diag
+    eps = COINCIDENT_REL * diag
     pairs = cKDTree(pts).query_pairs(eps, output_type="ndarray")
     uf = UnionFind(len(pts))
     uf.union_pairs(pairs.tolist())
@@ -207,7 +203,7 @@ def _snap_exact(strokes, src, labels, diag):
     verts = pts[uniq]
     offs = np.cumsum([0] + [len(s) for s in strokes])
     polys = [ids[offs[k]:offs[k + 1]] for k in range(len(strokes))]
-    net = _indexed_network(verts, polys, labels, src)
+    net = indexed_network(verts, polys, labels, src)
     net.report = dict.fromkeys(_COUNTERS, 0)
     net.report.update(mode="exact", warnings=[],
                       closed_strokes=sum(1 for e in net.edges if e.u == e.v))

@@ -45,7 +45,9 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ._inputs import check_strokes
+from curvenet.core.geometry import arc_length, face_normals_areas, resample_polyline, sample_surface
+from curvenet.core.strokes import check_strokes
+
 from .presets import CREASE_PRESETS, CreaseConfig, crease_config
 from .training import Stage, Step, seeded, torch_device, train
 
@@ -252,13 +254,8 @@ def segment_strip_2d(corner, direction, width: float, *, pieces: int = 2
 
 
 def _resample(p, step):
-    seg = np.linalg.norm(np.diff(p, axis=0), axis=1)
-    s = np.concatenate([[0.0], np.cumsum(seg)])
-    if s[-1] <= 0:
-        return p[[0, -1]]
-    k = max(1, int(math.ceil(s[-1] / step)))
-    u = np.linspace(0.0, s[-1], k + 1)
-    return np.stack([np.interp(u, s, p[:, j]) for j in range(p.shape[1])], 1)
+    """Equal arc-length pieces of at most ``step`` (one piece for a zero-length stroke)."""
+    return resample_polyline(p, max(1, math.ceil(arc_length(p) / step)))
 
 
 def _stroke_graph(strokes, tol):
@@ -366,16 +363,10 @@ class CreaseResult:
 
 
 def _sample_mesh(v, f, n, rng):
-    tri = v[f]
-    cr = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-    area = np.linalg.norm(cr, axis=1)
-    fid = rng.choice(len(f), size=n, p=area / area.sum())
-    r1, r2 = rng.random(n), rng.random(n)
-    s = np.sqrt(r1)
-    bary = np.stack([1 - s, s * (1 - r2), s * r2], 1)
-    pts = np.einsum("nk,nkd->nd", bary, tri[fid])
-    nrm = cr[fid] / np.maximum(area[fid], 1e-300)[:, None]
-    return pts, nrm
+    """``n`` area-uniform points ``(n, 3)`` on the mesh and the unit normals of their faces."""
+    normals, areas = face_normals_areas(v, f)
+    pts, fid = sample_surface(v, f, n, rng, areas=areas)
+    return pts, normals[fid]
 
 
 def _check_inputs(vertices, faces, strokes, labels):
@@ -386,7 +377,7 @@ def _check_inputs(vertices, faces, strokes, labels):
     if f.ndim != 2 or f.shape[1] != 3 or len(f) == 0 or f.min() < 0 or f.max() >= len(v):
         raise ValueError(f"faces must be a non-empty (F, 3) index array into vertices, "
                          f"got shape {f.shape}")
-    st, lab = check_strokes(list(strokes), labels, allow_empty=True)
+    st, lab = check_strokes(list(strokes), labels, default_label="crease")
     return v, f, st, lab
 
 

@@ -31,8 +31,10 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
+from curvenet.core.geometry import densify_polyline
+
 __all__ = ["marching_cubes_world", "face_components", "keep_supported_components",
-           "cut_along_boundary", "resample_polyline"]
+           "cut_along_boundary"]
 
 
 def marching_cubes_world(f_grid: np.ndarray, origin: np.ndarray, spacing: float,
@@ -74,22 +76,10 @@ def face_components(faces: np.ndarray, n_vertices: int) -> np.ndarray:
     return lab
 
 
-def resample_polyline(points: np.ndarray, step: float) -> np.ndarray:
-    """Points along a polyline at most ``step`` apart (vertices included)."""
-    p = np.asarray(points, float)
-    if len(p) < 2:
-        return p
-    seg = np.diff(p, axis=0)
-    k = np.maximum(1, np.ceil(np.linalg.norm(seg, axis=1) / step).astype(int))
-    t = np.concatenate([np.arange(m) / m for m in k])
-    i = np.repeat(np.arange(len(seg)), k)
-    return np.vstack([p[i] + t[:, None] * seg[i], p[-1:]])
-
-
 def _near(vertices, strokes, tol):
     if not strokes:
         return np.zeros(len(vertices), dtype=bool)
-    pts = np.vstack([resample_polyline(s, tol / 2) for s in strokes])
+    pts = np.vstack([densify_polyline(s, tol / 2) for s in strokes])
     d, _ = cKDTree(pts).query(vertices, distance_upper_bound=tol)
     return np.isfinite(d)
 

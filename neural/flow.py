@@ -71,7 +71,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._inputs import check_strokes
+from curvenet.core.geometry import face_normals_areas, sample_surface
+from curvenet.core.strokes import check_strokes
+
 from .presets import FlowConfig, get_config
 from .training import Stage, Step, seeded, torch_device, train
 
@@ -238,19 +240,15 @@ def sample_surface_marching_cubes(f_grid, n: int, rng: np.random.Generator):
     V, Fc = marching_cubes_world(f_grid.detach().cpu().numpy(), np.full(3, 0.5 / res), 1.0 / res)
     if len(Fc) == 0:
         return None
-    return _sample_triangles(V[Fc], n, rng)
+    return _sample_triangles(V, Fc, n, rng)
 
 
-def _sample_triangles(tri, n, rng):
-    """``n`` area-uniform points on triangles ``tri`` (T, 3, 3), or None if all degenerate."""
-    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
-    if not area.sum() > 0:
+def _sample_triangles(V, F, n, rng):
+    """``n`` area-uniform points ``(n, 3)`` on the mesh ``(V, F)``, or None if all degenerate."""
+    areas = face_normals_areas(V, F)[1]
+    if not areas.sum() > 0:
         return None
-    k = rng.choice(len(tri), size=n, p=area / area.sum())
-    r1, r2 = rng.random((2, n))
-    s = np.sqrt(r1)
-    w = np.stack([1 - s, s * (1 - r2), s * r2], 1)
-    return np.einsum("nk,nkd->nd", w, tri[k])
+    return sample_surface(V, F, n, rng, areas=areas)[0]
 
 
 def _prefit_targets(init_mesh, frame: Frame, sigma, rng, n=20000):
@@ -260,7 +258,7 @@ def _prefit_targets(init_mesh, frame: Frame, sigma, rng, n=20000):
     F = np.asarray(init_mesh[1], dtype=np.int64)
     if V.ndim != 2 or V.shape[1] != 3 or F.ndim != 2 or F.shape[1] != 3 or len(F) == 0:
         raise ValueError("init_mesh must be (vertices (V, 3), faces (F, 3)) with F >= 1")
-    surf = _sample_triangles(V[F], n // 2, rng)
+    surf = _sample_triangles(V, F, n // 2, rng)
     if surf is None:
         raise ValueError("init_mesh has only degenerate faces")
     near = surf + rng.normal(scale=0.02, size=surf.shape)
@@ -275,7 +273,7 @@ def _prefit_targets(init_mesh, frame: Frame, sigma, rng, n=20000):
 
 
 def _check_strokes(strokes, labels):
-    out, labels = check_strokes(strokes, labels)
+    out, labels = check_strokes(strokes, labels, default_label="crease", allow_empty=False)
     keep = [i for i, lab in enumerate(labels) if lab != "construction"]
     if not keep:
         raise ValueError("all strokes are construction strokes; nothing to surface")

@@ -49,7 +49,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from .coons import coons_eval, coons_grid
-from .polyline import resample
+from curvenet.core.geometry import resample_polyline
 from .sides import DEFAULT_STRAIGHT_ANGLE, group_sides
 
 __all__ = ["ControlMesh", "build_control_mesh", "orient_loops", "curve_pieces", "JUNCTION_TOL"]
@@ -78,7 +78,7 @@ def curve_pieces(curves: list, closed: np.ndarray) -> np.ndarray:
     med = float(np.median(lengths)) if len(lengths) else 1.0
     turn = np.empty(len(curves))
     for i, c in enumerate(curves):
-        d = np.diff(resample(c, 32), axis=0)
+        d = np.diff(resample_polyline(c, 32), axis=0)
         d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
         turn[i] = np.degrees(np.arccos(np.clip((d[1:] * d[:-1]).sum(1), -1, 1))).sum()
     m = np.maximum(np.ceil(lengths / (PIECE_LENGTH * max(med, 1e-300))),
@@ -385,7 +385,7 @@ def _sample_curves(curves, jend, jpos, k_c):
     samples = []
     nid = len(jpos)
     for i, c in enumerate(curves):
-        s = resample(c, int(k_c[i]))
+        s = resample_polyline(c, int(k_c[i]))
         s[0], s[-1] = jpos[jend[i, 0]], jpos[jend[i, 1]]
         ids = np.concatenate([[jend[i, 0]], nid + np.arange(k_c[i] - 1), [jend[i, 1]]])
         nid += k_c[i] - 1

@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .polyline import sample_at
+from curvenet.core.geometry import sample_at
 
 __all__ = ["hermite_blend", "coons_grid", "coons_eval"]
 

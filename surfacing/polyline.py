@@ -1,4 +1,6 @@
-"""Polyline helpers: arc length, uniform resampling, end tangents, point-to-polyline distance.
+"""Polyline helpers of the classical surfacer: end tangents, point-to-polyline distance.
+
+Arc length, interpolation and resampling live in :mod:`curvenet.core.geometry`.
 
 Notes
 -----
@@ -10,70 +12,10 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["arc_length_params", "resample", "end_tangents", "point_polyline_distance",
-           "sample_at"]
+from curvenet.core.geometry import sample_at
+from curvenet.core.tolerances import DIVISION_GUARD
 
-#: Relative length under which a segment counts as degenerate (fraction of the total length).
-_EPS_LEN = 1e-12
-
-
-def arc_length_params(curve: np.ndarray) -> np.ndarray:
-    """Normalised cumulative arc length of a polyline.
-
-    Parameters
-    ----------
-    curve : (m, 3) float64
-
-    Returns
-    -------
-    t : (m,) float64
-        ``t[0] = 0``, ``t[-1] = 1``, non-decreasing. A zero-length curve gets
-        uniform parameters (index / (m - 1)).
-    """
-    curve = np.asarray(curve, dtype=np.float64)
-    seg = np.linalg.norm(np.diff(curve, axis=0), axis=1)
-    cum = np.concatenate([[0.0], np.cumsum(seg)])
-    total = cum[-1]
-    if total <= _EPS_LEN:
-        return np.linspace(0.0, 1.0, len(curve))
-    return cum / total
-
-
-def sample_at(curve: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Points of ``curve`` at normalised arc-length parameters ``t`` (linear interpolation).
-
-    Parameters
-    ----------
-    curve : (m, 3) float64
-    t : (k,) float64 in [0, 1]
-
-    Returns
-    -------
-    (k, 3) float64
-    """
-    curve = np.asarray(curve, dtype=np.float64)
-    s = arc_length_params(curve)
-    t = np.clip(np.asarray(t, dtype=np.float64), 0.0, 1.0)
-    return np.stack([np.interp(t, s, curve[:, d]) for d in range(3)], axis=1)
-
-
-def resample(curve: np.ndarray, k: int) -> np.ndarray:
-    """Resample a polyline into ``k`` segments of equal arc length.
-
-    Parameters
-    ----------
-    curve : (m, 3) float64
-    k : int, >= 1
-
-    Returns
-    -------
-    (k + 1, 3) float64
-        First and last points are exactly ``curve[0]`` and ``curve[-1]``.
-    """
-    curve = np.asarray(curve, dtype=np.float64)
-    out = sample_at(curve, np.linspace(0.0, 1.0, k + 1))
-    out[0], out[-1] = curve[0], curve[-1]
-    return out
+__all__ = ["end_tangents", "point_polyline_distance"]
 
 
 def end_tangents(curve: np.ndarray, fraction: float = 0.1) -> tuple[np.ndarray, np.ndarray]:
@@ -116,7 +58,7 @@ def point_polyline_distance(points: np.ndarray, curve: np.ndarray) -> np.ndarray
     curve = np.asarray(curve, dtype=np.float64)
     a, b = curve[:-1], curve[1:]                                  # (s, 3)
     ab = b - a
-    den = np.maximum(np.einsum("ij,ij->i", ab, ab), 1e-300)       # guard zero-length segments
+    den = np.maximum(np.einsum("ij,ij->i", ab, ab), DIVISION_GUARD)  # zero-length segments
     ap = points[:, None, :] - a[None]                             # (k, s, 3)
     t = np.clip(np.einsum("ksj,sj->ks", ap, ab) / den, 0.0, 1.0)
     d = ap - t[..., None] * ab[None]

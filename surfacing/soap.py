@@ -22,7 +22,7 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from scipy.spatial import Delaunay
 
-from .polyline import arc_length_params, resample
+from curvenet.core.geometry import arc_length_params, resample_polyline
 
 __all__ = ["disk_triangulation", "soapfilm_patch", "soapfilm_mesh"]
 
@@ -142,14 +142,14 @@ def soapfilm_mesh(curves, loops, *, resolution: int = 16):
     """
     if int(resolution) < 1:
         raise ValueError(f"resolution: expected >= 1, got {resolution!r}")
-    samples = [resample(np.asarray(c, np.float64), int(resolution)) for c in curves]
+    samples = [resample_polyline(np.asarray(c, np.float64), int(resolution)) for c in curves]
     Vs, Fs, P = [], [], []
     off = 0
     for j, lp in enumerate(loops):
         pts = [samples[ci][:-1] if fwd else samples[ci][::-1][:-1] for ci, fwd in lp]
         B = np.concatenate(pts)
         if len(B) < 3:              # a loop of one short curve: resample finer
-            B = resample(np.concatenate([B, B[:1]]), 3)[:-1]
+            B = resample_polyline(np.concatenate([B, B[:1]]), 3)[:-1]
         V, F = soapfilm_patch(B)
         Vs.append(V)
         Fs.append(F + off)

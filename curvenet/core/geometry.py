@@ -56,8 +56,8 @@ def as_polyline(points, *, name: str = "polyline", min_points: int = 2) -> np.nd
     Raises
     ------
     InvalidParameterError
-        Not numbers, wrong shape, fewer than ``min_points`` points, or a NaN/inf
-        coordinate.
+        Not numbers, a number beyond the float range, wrong shape, fewer than
+        ``min_points`` points, or a NaN/inf coordinate.
 
     Examples
     --------
@@ -68,6 +68,8 @@ def as_polyline(points, *, name: str = "polyline", min_points: int = 2) -> np.nd
         arr = np.array(points, dtype=np.float64, copy=True)
     except (TypeError, ValueError):
         raise InvalidParameterError(f"{name}: points are not numbers") from None
+    except OverflowError:  # an integer beyond the float range (JSON allows any)
+        raise InvalidParameterError(f"{name}: a coordinate is too large for a float") from None
     if arr.size == 0:
         arr = arr.reshape(0, 3)
     if arr.ndim != 2 or arr.shape[1] != 3:

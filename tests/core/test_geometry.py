@@ -157,6 +157,7 @@ def test_sampling_rejects_zero_area():
     ([[0, 0], [1, 1]], r"\(n, 3\)"),
     ([[[0, 0, 0]]], r"\(n, 3\)"),
     ([["a", "b", "c"], [0, 0, 0]], "not numbers"),
+    ([[10 ** 400, 0, 0], [0, 0, 0]], "too large for a float"),
 ])
 def test_as_polyline_rejects_with_named_errors(bad, words):
     with pytest.raises(InvalidParameterError, match=r"^strokes\[3\]: .*" + words):

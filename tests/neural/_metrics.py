@@ -7,14 +7,7 @@ longest bounding-box side is 1.
 
 import numpy as np
 
-
-def sample_mesh(V, F, n, rng):
-    tri = np.asarray(V, float)[np.asarray(F)]
-    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
-    k = rng.choice(len(F), n, p=area / area.sum())
-    r1, r2 = rng.random((2, n))
-    s = np.sqrt(r1)
-    return np.einsum("nk,nkd->nd", np.stack([1 - s, s * (1 - r2), s * r2], 1), tri[k])
+from curvenet.core.geometry import sample_surface
 
 
 def fscore(V, F, Vr, Fr, *, threshold=0.01, n=20000, seed=0):
@@ -26,7 +19,7 @@ def fscore(V, F, Vr, Fr, *, threshold=0.01, n=20000, seed=0):
         return 0.0, float("inf")
     scale = 1.0 / np.max(Vr.max(0) - Vr.min(0))
     rng = np.random.default_rng(seed)
-    pa, pb = sample_mesh(V, F, n, rng), sample_mesh(Vr, Fr, n, rng)
+    pa, pb = sample_surface(V, F, n, rng)[0], sample_surface(Vr, Fr, n, rng)[0]
     da = np.sqrt(igl.point_mesh_squared_distance(pa, Vr, Fr)[0]) * scale
     db = np.sqrt(igl.point_mesh_squared_distance(pb, V, F)[0]) * scale
     prec, rec = (da < threshold).mean(), (db < threshold).mean()

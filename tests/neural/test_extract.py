@@ -4,7 +4,7 @@ import numpy as np
 import trimesh
 
 from curvenet.neural.extract import (cut_along_boundary, face_components, keep_supported_components,
-                            marching_cubes_world, resample_polyline)
+                                     marching_cubes_world)
 
 
 def _sphere_grid(n=40, r=0.3):
@@ -59,10 +59,3 @@ def test_cut_removes_unsupported_cap_beyond_boundary_loop():
     assert len(F1) == len(m.faces)
     V2, F2 = cut_along_boundary(m.vertices, m.faces, [arc], [equator], band=0.05)
     assert len(F2) == len(m.faces)
-
-
-def test_resample_polyline_spacing():
-    p = np.array([[0.0, 0, 0], [1.0, 0, 0], [1.0, 2.0, 0]])
-    q = resample_polyline(p, 0.1)
-    assert np.linalg.norm(np.diff(q, axis=0), axis=1).max() <= 0.1 + 1e-12
-    assert np.allclose(q[0], p[0]) and np.allclose(q[-1], p[-1])

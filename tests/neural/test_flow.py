@@ -118,7 +118,7 @@ def test_dirichlet_boundary_closes_capped_cylinder():
 @pytest.mark.parametrize("kw,match", [
     (dict(strokes=[]), "strokes"),
     (dict(strokes=[np.zeros((1, 3))]), r"strokes\[0\]"),
-    (dict(strokes=[np.full((3, 3), np.nan)]), "non-finite"),
+    (dict(strokes=[np.full((3, 3), np.nan)]), "NaN"),
     (dict(strokes=[np.zeros((3, 3))]), "zero"),
     (dict(labels=["flow", "crease", "crease"]), r"labels\[0\]"),
     (dict(labels=["crease"]), "labels"),

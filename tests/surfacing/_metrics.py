@@ -10,15 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-
-def _sample(V, F, n, rng):
-    a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
-    area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
-    idx = rng.choice(len(F), size=n, p=area / area.sum())
-    r1, r2 = rng.random(n), rng.random(n)
-    s = np.sqrt(r1)
-    return ((1 - s)[:, None] * a[idx] + (s * (1 - r2))[:, None] * b[idx]
-            + (s * r2)[:, None] * c[idx])
+from curvenet.core.geometry import sample_surface
 
 
 def _dist(points, V, F):
@@ -35,8 +27,8 @@ def compare(V, F, Vref, Fref, *, n=20000, threshold=0.01, seed=0):
     scale = 1.0 / (Vref.max(0) - lo).max()
     V, Vref = (V - lo) * scale, (Vref - lo) * scale
     rng = np.random.default_rng(seed)
-    d_pr = _dist(_sample(V, F, n, rng), Vref, Fref)     # ours -> reference (precision)
-    d_rc = _dist(_sample(Vref, Fref, n, rng), V, F)      # reference -> ours (recall)
+    d_pr = _dist(sample_surface(V, F, n, rng)[0], Vref, Fref)     # ours -> reference (precision)
+    d_rc = _dist(sample_surface(Vref, Fref, n, rng)[0], V, F)      # reference -> ours (recall)
     p, r = (d_pr < threshold).mean(), (d_rc < threshold).mean()
     f = 2 * p * r / (p + r) if p + r > 0 else 0.0
     return {"chamfer": 0.5 * (d_pr.mean() + d_rc.mean()), "fscore": f, "precision": p,

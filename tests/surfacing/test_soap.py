@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from curvenet.surfacing.polyline import arc_length_params
+from curvenet.core.geometry import arc_length_params
 from curvenet.surfacing.soap import (_cotan_laplacian, disk_triangulation, soapfilm_mesh,
                                      soapfilm_patch)
 
