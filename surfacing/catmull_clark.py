@@ -34,8 +34,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-__all__ = ["EdgeTopology", "edge_topology", "edge_index", "vertex_classes",
-           "SubdivisionStep", "subdivision_step", "subdivide", "euler_characteristic"]
+__all__ = ["EdgeTopology", "edge_topology", "edge_index", "sharp_mask", "vertex_classes",
+           "crease_neighbours", "SubdivisionStep", "subdivision_step", "subdivide",
+           "euler_characteristic"]
 
 SMOOTH, CREASE, CORNER = 0, 1, 2
 
@@ -105,7 +106,20 @@ def edge_index(topo: EdgeTopology, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.where(ok, pos, -1)
 
 
-def _sharp_mask(topo: EdgeTopology, sharp_edges) -> np.ndarray:
+def sharp_mask(topo: EdgeTopology, sharp_edges) -> np.ndarray:
+    """Sharp-edge mask: boundary and non-manifold edges, plus the marked ones.
+
+    Parameters
+    ----------
+    topo : EdgeTopology
+    sharp_edges : (k, 2) int array_like or None
+        Vertex pairs of edges marked sharp; pairs that are not edges are ignored.
+
+    Returns
+    -------
+    (e,) bool
+        Indexed like ``topo.edges``.
+    """
     sharp = topo.face_count != 2
     if sharp_edges is not None and len(sharp_edges):
         se = np.asarray(sharp_edges, dtype=np.int64).reshape(-1, 2)
@@ -144,8 +158,22 @@ def vertex_classes(topo: EdgeTopology, sharp: np.ndarray, corners=None) -> np.nd
     return cls
 
 
-def _crease_neighbours(topo: EdgeTopology, sharp: np.ndarray, cls: np.ndarray):
-    """For each CREASE vertex, its two neighbours along sharp edges: (verts, nb0, nb1)."""
+def crease_neighbours(topo: EdgeTopology, sharp: np.ndarray, cls: np.ndarray):
+    """For each CREASE vertex, its two neighbours along sharp edges.
+
+    Parameters
+    ----------
+    topo : EdgeTopology
+    sharp : (e,) bool
+        Sharp-edge mask (:func:`sharp_mask`).
+    cls : (n,) int
+        Vertex classes (:func:`vertex_classes`).
+
+    Returns
+    -------
+    verts, nb0, nb1 : (c,) int64
+        The crease vertices in increasing order and their two sharp neighbours.
+    """
     se = topo.edges[sharp]
     ends = np.concatenate([se, se[:, ::-1]])          # (2s, 2): (vertex, neighbour)
     ends = ends[cls[ends[:, 0]] == CREASE]
@@ -220,7 +248,7 @@ def subdivision_step(quads, n_vertices: int, sharp_edges=None, corners=None) -> 
     n = int(n_vertices)
     topo = edge_topology(quads, n)
     nf, ne = len(quads), len(topo.edges)
-    sharp = _sharp_mask(topo, sharp_edges)
+    sharp = sharp_mask(topo, sharp_edges)
     cls = vertex_classes(topo, sharp, corners)
     rows, cols, vals = [], [], []
 
@@ -271,7 +299,7 @@ def subdivision_step(quads, n_vertices: int, sharp_edges=None, corners=None) -> 
     cols.append(quads[face_of[mm]].ravel())
     vals.append(np.repeat(wq, 4))
     # crease vertices
-    cv, nb0, nb1 = _crease_neighbours(topo, sharp, cls)
+    cv, nb0, nb1 = crease_neighbours(topo, sharp, cls)
     rows += [cv, cv, cv]
     cols += [cv, nb0, nb1]
     vals += [np.full(len(cv), 0.75), np.full(len(cv), 0.125), np.full(len(cv), 0.125)]

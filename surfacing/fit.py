@@ -27,7 +27,7 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
-from .catmull_clark import CORNER, CREASE, _sharp_mask, edge_topology, vertex_classes
+from .catmull_clark import CORNER, CREASE, edge_topology, sharp_mask, vertex_classes
 from .limit import limit_normals
 
 __all__ = ["LAMBDA", "VSPRING_STEP", "FAIRNESS", "fairness_matrix", "variation_matrix", "fit_lsq",
@@ -58,7 +58,7 @@ def fairness_matrix(quads, n_vertices: int, sharp_edges=None, corners=None) -> s
     """
     n = int(n_vertices)
     topo = edge_topology(quads, n)
-    sharp = _sharp_mask(topo, sharp_edges)
+    sharp = sharp_mask(topo, sharp_edges)
     cls = vertex_classes(topo, sharp, corners)
     e = topo.edges
     both = np.concatenate([e, e[:, ::-1]])
@@ -244,7 +244,7 @@ def fit_iterative(L, T1, T2, has_tangent, quads, P0, constrained, targets, *,
     free[constrained] = False
     topo = edge_topology(quads, n)
     edges = topo.edges
-    cls = vertex_classes(topo, _sharp_mask(topo, sharp_edges), corners)
+    cls = vertex_classes(topo, sharp_mask(topo, sharp_edges), corners)
     smooth = cls == 0
     iterations = 0
     for iterations in range(1, max_iter + 1):  # noqa: B007 (reported after the loop)

@@ -32,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
-from .catmull_clark import (CREASE, SMOOTH, _crease_neighbours, _sharp_mask, edge_topology,
+from .catmull_clark import (CREASE, SMOOTH, crease_neighbours, edge_topology, sharp_mask,
                             vertex_classes)
 
 __all__ = ["limit_matrix", "tangent_matrices", "limit_normals", "quad_vertex_normals"]
@@ -59,7 +59,7 @@ def limit_matrix(quads, n_vertices: int, sharp_edges=None, corners=None) -> sp.c
     quads = np.asarray(quads, dtype=np.int64)
     n = int(n_vertices)
     topo = edge_topology(quads, n)
-    sharp = _sharp_mask(topo, sharp_edges)
+    sharp = sharp_mask(topo, sharp_edges)
     cls = vertex_classes(topo, sharp, corners)
     val = np.bincount(topo.edges.ravel(), minlength=n).astype(np.float64)
     smooth = cls == SMOOTH
@@ -80,7 +80,7 @@ def limit_matrix(quads, n_vertices: int, sharp_edges=None, corners=None) -> sp.c
     rows.append(cv[m])
     cols.append(diag[m])
     vals.append(1.0 / (val[cv[m]] * (val[cv[m]] + 5.0)))
-    c, a, b = _crease_neighbours(topo, sharp, cls)
+    c, a, b = crease_neighbours(topo, sharp, cls)
     rows += [c, c, c]
     cols += [c, a, b]
     vals += [np.full(len(c), 4.0 / 6.0), np.full(len(c), 1.0 / 6.0), np.full(len(c), 1.0 / 6.0)]
@@ -155,7 +155,7 @@ def tangent_matrices(quads, n_vertices: int, sharp_edges=None, corners=None):
     quads = np.asarray(quads, dtype=np.int64)
     n = int(n_vertices)
     topo = edge_topology(quads, n)
-    sharp = _sharp_mask(topo, sharp_edges)
+    sharp = sharp_mask(topo, sharp_edges)
     cls = vertex_classes(topo, sharp, corners)
     val = np.bincount(topo.edges.ravel(), minlength=n)
     vs = np.flatnonzero(cls == SMOOTH)
