@@ -220,12 +220,11 @@ def _worker_name() -> str:
 class LocalExecutor:
     """Run tasks in this process (``jobs=1``) or a pool of ``jobs`` processes.
 
-    Tasks carry paths. A pool whose process dies is replaced and the unfinished tasks
-    resubmitted, at most :attr:`MAX_RESTARTS` times; what is left then is reported as
-    ``internal``.
+    Tasks carry paths. When a pool process dies (a crash in native code, the kernel's
+    out-of-memory killer), the whole pool breaks; the unfinished tasks then run one per
+    fresh process (``jobs`` at a time), so a crash costs only its own file, which is
+    reported as ``internal``.
     """
-
-    MAX_RESTARTS = 3
 
     def __init__(self, jobs: int = 1):
         if not isinstance(jobs, int) or jobs < 1:
@@ -239,25 +238,33 @@ class LocalExecutor:
             for i, path in enumerate(tasks):
                 yield i, surface_task(path, None, options, **render)
             return
-        from concurrent.futures import ProcessPoolExecutor, as_completed
+        from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor, as_completed
         from concurrent.futures.process import BrokenProcessPool
-        todo = list(range(len(tasks)))
-        for _attempt in range(self.MAX_RESTARTS + 1):
-            with ProcessPoolExecutor(max_workers=self.jobs) as pool:
-                futures = {pool.submit(surface_task, tasks[i], None, options, **render): i
-                           for i in todo}
-                broken = []
-                for fut in as_completed(futures):
-                    try:
-                        yield futures[fut], fut.result()
-                    except BrokenProcessPool:
-                        broken.append(futures[fut])
-            todo = sorted(broken)
-            if not todo:
-                return
-        for i in todo:
-            yield i, _lost_row(tasks[i], "a worker process died (pool broken "
-                                         f"{self.MAX_RESTARTS + 1} times)")
+        broken = []
+        with ProcessPoolExecutor(max_workers=self.jobs) as pool:
+            futures = {pool.submit(surface_task, path, None, options, **render): i
+                       for i, path in enumerate(tasks)}
+            for fut in as_completed(futures):
+                try:
+                    yield futures[fut], fut.result()
+                except BrokenProcessPool:
+                    broken.append(futures[fut])
+        with ThreadPoolExecutor(self.jobs) as threads:
+            futures = {threads.submit(_isolated, tasks[i], options, render): i
+                       for i in sorted(broken)}
+            for fut in as_completed(futures):
+                yield futures[fut], fut.result()
+
+
+def _isolated(path: str, options: BatchOptions, render: dict) -> dict:
+    """Run one task in a process of its own; its death is this file's failure alone."""
+    from concurrent.futures import ProcessPoolExecutor
+    from concurrent.futures.process import BrokenProcessPool
+    with ProcessPoolExecutor(max_workers=1) as pool:
+        try:
+            return pool.submit(surface_task, path, None, options, **render).result()
+        except BrokenProcessPool:
+            return _lost_row(path, "its worker process died")
 
 
 class DaskExecutor:

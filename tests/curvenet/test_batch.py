@@ -127,6 +127,30 @@ def test_report_rows_and_contact_sheet(tmp_path):
         "box.png", "capped_cylinder.png", "contact_sheet.png", "house.png", "l_prism.png"]
 
 
+def _crashing_task(path, data, options, **kw):
+    """``surface_task``, but the process dies (as in a native crash) on house.obj."""
+    if path.endswith("house.obj"):
+        os._exit(3)
+    return _REAL_TASK(path, data, options, **kw)
+
+
+_REAL_TASK = __import__("curvenet.batch").batch.surface_task
+
+
+@pytest.mark.skipif(__import__("multiprocessing").get_start_method() != "fork",
+                    reason="the crash is injected into forked pool processes")
+def test_a_pool_process_that_dies_costs_only_its_own_file(tmp_path, monkeypatch):
+    import curvenet.batch
+    from curvenet.batch import LocalExecutor
+    inputs = _shapes(tmp_path / "in") + _boxes(tmp_path / "in", 2)
+    monkeypatch.setattr(curvenet.batch, "surface_task", _crashing_task)
+    res = run_batch(inputs, tmp_path / "out", BatchOptions(method="classical"),
+                    executor=LocalExecutor(2))
+    status = {os.path.basename(r["input"]): r["status"] for r in res.rows}
+    assert status.pop("house.obj") == "internal"
+    assert set(status.values()) == {"ok"} and res.exit_code == 1
+
+
 # --------------------------------------------------------------------------- resuming
 def test_an_interrupted_batch_of_20_restarts_where_it_stopped(tmp_path):
     inputs = _boxes(tmp_path / "in", 20)
