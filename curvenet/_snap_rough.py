@@ -11,6 +11,7 @@ from scipy.ndimage import maximum_filter1d
 from scipy.spatial import cKDTree
 
 from .core.geometry import arc_length, cumulative_length, interpolate_polyline, resample_polyline
+from .core.tolerances import DIVISION_GUARD
 from .network import CurveNetwork
 
 __all__ = ["UnionFind", "dedup", "snap_rough"]
@@ -136,7 +137,7 @@ class _Flat:
         g = np.clip(np.asarray(s, dtype=np.float64), 0.0, self.L[k]) + self.off[k]
         j = np.clip(np.searchsorted(self.G, g, side="right") - 1, 0, len(self.G) - 2)
         seg = self.G[j + 1] - self.G[j]
-        t = np.clip((g - self.G[j]) / np.maximum(seg, 1e-300), 0.0, 1.0)  # guard 0-length
+        t = np.clip((g - self.G[j]) / np.maximum(seg, DIVISION_GUARD), 0.0, 1.0)  # guard 0-length
         return self.P[j] + t[:, None] * (self.P[j + 1] - self.P[j])
 
 
@@ -160,7 +161,7 @@ def _sample(st, h):
     nxt = np.minimum(np.arange(len(Q)) + 1, start[sid + 1] - 1)
     prv = np.maximum(np.arange(len(Q)) - 1, start[sid])
     tan = Q[nxt] - Q[prv]
-    tan /= np.maximum(np.linalg.norm(tan, axis=1, keepdims=True), 1e-300)  # guard 0-length
+    tan /= np.maximum(np.linalg.norm(tan, axis=1, keepdims=True), DIVISION_GUARD)  # guard 0-length
     return Q, sid, ss, tan, start, flat
 
 
@@ -232,8 +233,8 @@ def _consolidate(st, samples, con, tol, h, opts, report):
         if a in busy or b in busy:
             continue
         busy.update((a, b))
-        cov_a = (con["a1"][c] - con["a0"][c]) / max(st.length(a), 1e-300)
-        cov_b = (con["b1"][c] - con["b0"][c]) / max(st.length(b), 1e-300)
+        cov_a = (con["a1"][c] - con["a0"][c]) / max(st.length(a), DIVISION_GUARD)
+        cov_b = (con["b1"][c] - con["b0"][c]) / max(st.length(b), DIVISION_GUARD)
         if cov_a > cov_b or (cov_a == cov_b and a > b):
             guest, host = a, b
             g0, g1, h0, h1 = con["a0"][c], con["a1"][c], con["b0"][c], con["b1"][c]
@@ -283,7 +284,7 @@ def _consolidate(st, samples, con, tol, h, opts, report):
         inside = (hc >= a0) & (hc <= a1)
         if inside.any():
             x = hc[inside]
-            ramp = max(min(2.0 * tol, 0.5 * (h1 - h0)), 1e-300)  # guard: empty overlap
+            ramp = max(min(2.0 * tol, 0.5 * (h1 - h0)), DIVISION_GUARD)  # guard: empty overlap
             lo_f = (1.0 + _smoothstep((h0 + ramp - x) / ramp) if "head" in join
                     else _smoothstep((x - h0) / ramp))
             hi_f = (1.0 + _smoothstep((x - h1 + ramp) / ramp) if "tail" in join
@@ -340,13 +341,13 @@ def _seg_seg(p0, p1, q0, q1):
         The closest points are ``p0 + s (p1 - p0)`` and ``q0 + t (q1 - q0)``.
     """
     d1, d2, r = p1 - p0, q1 - q0, p0 - q0
-    a = np.maximum(np.einsum("ij,ij->i", d1, d1), 1e-300)  # guard: degenerate segments
-    e = np.maximum(np.einsum("ij,ij->i", d2, d2), 1e-300)
+    a = np.maximum(np.einsum("ij,ij->i", d1, d1), DIVISION_GUARD)  # guard: degenerate segments
+    e = np.maximum(np.einsum("ij,ij->i", d2, d2), DIVISION_GUARD)
     b = np.einsum("ij,ij->i", d1, d2)
     c = np.einsum("ij,ij->i", d1, r)
     f = np.einsum("ij,ij->i", d2, r)
     denom = a * e - b * b
-    par = denom <= 1e-12 * a * e  # parallel: any s works, take the start
+    par = denom <= 1e-12 * a * e  # parallel (sin^2 of the angle < 1e-12; local): take the start
     s = np.where(par, 0.0, np.clip((b * f - c * e) / np.where(par, 1.0, denom), 0.0, 1.0))
     t = (b * s + f) / e
     s = np.where(t < 0, np.clip(-c / a, 0, 1), np.where(t > 1, np.clip((b - c) / a, 0, 1), s))
@@ -515,8 +516,8 @@ def _corners(samples, tol, h, opts):
     pos = rel + np.repeat(start[:-1], n)
     p0, p1, p2 = flat.interp(kk, s - w), flat.interp(kk, s), flat.interp(kk, s + w)
     u, v = p1 - p0, p2 - p1
-    nu = np.maximum(np.linalg.norm(u, axis=1), 1e-300)  # guard 0-length chords
-    nv = np.maximum(np.linalg.norm(v, axis=1), 1e-300)
+    nu = np.maximum(np.linalg.norm(u, axis=1), DIVISION_GUARD)  # guard 0-length chords
+    nv = np.maximum(np.linalg.norm(v, axis=1), DIVISION_GUARD)
     ang = np.full(start[-1], -1.0)
     ang[pos] = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", u, v) / (nu * nv), -1, 1)))
     peak = (ang >= maximum_filter1d(ang, 2 * pad - 1, mode="nearest")) & (ang > opts.corner_angle)
@@ -545,7 +546,7 @@ def _displace_and_split(poly, cum, cuts, disp, tol, opts):
     k = len(cuts)
     gaps = np.diff(np.concatenate([[-np.inf], cuts, [np.inf]]))
     R = np.minimum(opts.blend * tol, 0.45 * np.minimum(gaps[:-1], gaps[1:]))
-    R = np.maximum(R, 1e-300)  # guard: coincident cuts are removed before this point
+    R = np.maximum(R, DIVISION_GUARD)  # guard: coincident cuts are removed before this point
     s_all = np.concatenate([cum, cuts])
     p_all = np.vstack([poly, interpolate_polyline(poly, cuts, cum=cum)])
     is_cut = np.concatenate([np.zeros(len(cum), bool), np.ones(k, bool)])
@@ -575,7 +576,7 @@ def _tangent_at(curve, at_start, w):
     d = np.linalg.norm(c - c[0], axis=1)
     far = np.flatnonzero(d >= w)
     vec = c[far[0] if far.size else -1] - c[0]
-    return vec / max(np.linalg.norm(vec), 1e-300)  # guard: degenerate curve
+    return vec / max(np.linalg.norm(vec), DIVISION_GUARD)  # guard: degenerate curve
 
 
 def _dissolve(edges, corner_ids, tol, opts, nverts):

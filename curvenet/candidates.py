@@ -23,6 +23,7 @@ from collections import deque
 import numpy as np
 
 from ._gf2 import edge_mask
+from .core.tolerances import DIVISION_GUARD
 from .errors import InvalidParameterError, NetworkError
 from .loops import cycle_to_loop, newell_normal
 from .network import CurveNetwork
@@ -302,7 +303,7 @@ class CandidatePool:
                 + np.einsum("s,si,sj->ij", seg / 3.0, b, b) \
                 + np.einsum("s,si,sj->ij", seg / 6.0, a, b) \
                 + np.einsum("s,si,sj->ij", seg / 6.0, b, a)
-        self.diagonal = max(self.network.diagonal, 1e-300)
+        self.diagonal = max(self.network.diagonal, DIVISION_GUARD)
 
     def measures(self, edge_lists):
         """Tie-break volume, area estimate, arc length and centroid of cycles.
@@ -333,7 +334,7 @@ class CandidatePool:
         n = len(idx)
         d = self.diagonal
         m0 = self._m0[idx].sum(axis=1)  # (n,)
-        m0s = np.maximum(m0, 1e-300)
+        m0s = np.maximum(m0, DIVISION_GUARD)
         cen = self._m1[idx].sum(axis=1) / m0s[:, None]  # (n, 3)
         if self.tie_break == "aabb":
             ext = self._emax[idx].max(axis=1) - self._emin[idx].min(axis=1)  # (n, 3)
@@ -343,7 +344,7 @@ class CandidatePool:
             cov = self._m2[idx].sum(axis=1) / m0s[:, None, None] \
                 - cen[:, :, None] * cen[:, None, :]  # (n, 3, 3)
             lam = np.linalg.eigvalsh(cov)  # ascending, (n, 3)
-            lam = np.where(lam < _FLAT_RTOL * np.maximum(lam[:, 2:], 1e-300), 0.0, lam)
+            lam = np.where(lam < _FLAT_RTOL * np.maximum(lam[:, 2:], DIVISION_GUARD), 0.0, lam)
             vol = np.sqrt(lam.prod(axis=1))
             area = 6.0 * np.sqrt(lam[:, 1] * lam[:, 2])
         if n == 0:
@@ -395,7 +396,7 @@ class CandidatePool:
             t[i, 0] = np.array([np.interp(d, s, c[:, k]) for k in range(3)]) - c[0]
             t[i, 1] = np.array([np.interp(s[-1] - d, s, c[:, k]) for k in range(3)]) - c[-1]
         n = np.linalg.norm(t, axis=2, keepdims=True)
-        return t / np.maximum(n, 1e-300)
+        return t / np.maximum(n, DIVISION_GUARD)
 
     def is_cutting(self, edges) -> bool:
         """Whether a cycle cuts through the surface instead of bounding a face (ours).

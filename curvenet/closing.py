@@ -18,6 +18,7 @@ import numpy as np
 
 from ._gf2 import bitset_solve, edge_mask, gf2_solve, mask_edges, popcount
 from .candidates import CandidatePool
+from .core.tolerances import DIVISION_GUARD
 from .loops import cycle_to_loop, newell_normal
 
 __all__ = ["closing_suggestions", "auto_close"]
@@ -141,7 +142,7 @@ def closing_suggestions(pool: CandidatePool, patch_edges, *, exclude=(), max_len
         if x is None:
             continue
         J = mask_edges(_smallest_in_coset(x, null))
-        ca = max(c.area, 1e-300)
+        ca = max(c.area, DIVISION_GUARD)
         a = (float(parea[list(J)].sum()) + c.area) / ca
         b = int((degree[list(c.edges)] == 1).sum())
         ws = _WS_FACTOR * (a + b) + c.length

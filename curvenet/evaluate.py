@@ -21,7 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from .core.geometry import as_polyline, densify_polyline, face_normals_areas, sample_surface
-from .core.tolerances import DEGENERATE_AREA_REL
+from .core.tolerances import DEGENERATE_AREA_REL, DIVISION_GUARD
 from .errors import InvalidParameterError, SketchFormatError
 
 __all__ = ["evaluate_mesh", "stroke_distance", "stroke_fidelity", "format_report",
@@ -115,7 +115,7 @@ def _drop_degenerate(vertices, faces):
     """Faces, unit normals and areas of the non-degenerate triangles only."""
     normals, areas = face_normals_areas(vertices, faces)
     diag2 = float(np.sum(np.ptp(vertices, axis=0) ** 2))
-    keep = areas > DEGENERATE_AREA_REL * max(diag2, np.finfo(float).tiny)
+    keep = areas > DEGENERATE_AREA_REL * max(diag2, DIVISION_GUARD)
     return faces[keep], normals[keep], areas[keep]
 
 
@@ -428,7 +428,7 @@ def stroke_fidelity(mesh, strokes, *, tol: float = FIDELITY_TOL_REL,
         raise InvalidParameterError(f"tol must be a number in (0, 1), got {tol!r}")
     d, _sketch_diag, v = _stroke_sample_distances(mesh, strokes, spacing)
     diag = float(np.linalg.norm(np.ptp(v, axis=0)))
-    d = d / max(diag, np.finfo(float).tiny)
+    d = d / max(diag, DIVISION_GUARD)
     return {"fidelity": float(np.mean(d < tol)), "median": float(np.median(d)),
             "p95": float(np.percentile(d, 95)), "diagonal": diag}
 

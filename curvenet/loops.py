@@ -12,6 +12,7 @@ from collections import deque
 
 import numpy as np
 
+from .core.tolerances import DIVISION_GUARD
 from .errors import NetworkError
 from .network import CurveNetwork
 from .patchset import Patch
@@ -118,7 +119,7 @@ def newell_normal(network, loop) -> np.ndarray:
     """
     p = loop_points(network, loop)
     n = np.cross(p, np.roll(p, -1, axis=0)).sum(axis=0)
-    return n / max(np.linalg.norm(n), 1e-300)
+    return n / max(np.linalg.norm(n), DIVISION_GUARD)
 
 
 def signed_volume(network, loops) -> float:

@@ -46,6 +46,7 @@ from scipy import sparse
 from scipy.sparse import csgraph
 from scipy.spatial import cKDTree
 
+from .core.tolerances import DIVISION_GUARD
 from .errors import InvalidParameterError, SketchFormatError
 from .sketch import Sketch
 
@@ -224,7 +225,7 @@ def _tree_distance(n, tree_e, tree_w, a, b):
     _, lab = csgraph.connected_components(_sym(n, tree_e, tree_w), directed=False)
     roots = np.unique(lab, return_index=True)[1]
     e = np.vstack([tree_e, np.column_stack([np.full(len(roots), n), roots])])
-    w = np.concatenate([tree_w, np.full(len(roots), 1e-300)])
+    w = np.concatenate([tree_w, np.full(len(roots), 1e-300)])  # local: > 0 keeps the edge stored
     g = _sym(n + 1, e, w)
     depth = csgraph.dijkstra(g, indices=n)
     hop = csgraph.dijkstra(g, indices=n, unweighted=True).astype(np.int64)
@@ -472,7 +473,7 @@ def _corners(poly, w):
     def turn(r):
         u, v = at(s[inside] - r / 3) - at(s[inside] - r), at(s[inside] + r) - at(s[inside] + r / 3)
         cos = np.einsum("ij,ij->i", u, v) / np.maximum(
-            np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1), 1e-300)
+            np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1), DIVISION_GUARD)
         return np.degrees(np.arccos(np.clip(cos, -1, 1)))
 
     turn, wide = turn(w), turn(2 * w)
@@ -576,7 +577,7 @@ def recover_curves(points, *, cell: float | None = None, name: str = "points",
     x, w = _nodes(p, cell)
     x = _project_lines(x, w, _SMOOTH_R * cell)
     pairs = cKDTree(x).query_pairs(_LINK_R * cell, output_type="ndarray")
-    length = np.linalg.norm(x[pairs[:, 0]] - x[pairs[:, 1]], axis=1) + 1e-9 * cell
+    length = np.linalg.norm(x[pairs[:, 0]] - x[pairs[:, 1]], axis=1) + 1e-9 * cell  # local: > 0
     mst = csgraph.minimum_spanning_tree(
         sparse.coo_matrix((length, (pairs[:, 0], pairs[:, 1])), shape=(len(x),) * 2)).tocoo()
     tree = np.column_stack([mst.row, mst.col]).astype(np.int64)

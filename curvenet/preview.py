@@ -15,6 +15,7 @@ import numpy as np
 
 from ._atomic import atomic_path
 from .core.geometry import as_polyline
+from .core.tolerances import COINCIDENT_REL, DIVISION_GUARD, ZERO_LENGTH
 from .errors import InvalidParameterError
 
 __all__ = ["render_preview", "patch_polygons", "decimate_clustering", "DEFAULT_VIEWS",
@@ -160,7 +161,7 @@ def decimate_clustering(vertices, faces, max_faces: int) -> tuple[np.ndarray, np
                                 axis=1).sum()
     lo = v.min(axis=0)
     diag = float(np.linalg.norm(np.ptp(v, axis=0)))
-    h = max(np.sqrt(2.0 * area / max_faces), 1e-9 * diag)
+    h = max(np.sqrt(2.0 * area / max_faces), COINCIDENT_REL * diag)
     for _ in range(20):
         keys = np.floor((v - lo) / h).astype(np.int64)  # (V, 3)
         _, inverse = np.unique(keys, axis=0, return_inverse=True)
@@ -193,7 +194,7 @@ def _shade(triangles, base, light, ambient=AMBIENT):
     ``ambient`` is a scalar or one value per triangle.
     """
     n = np.cross(triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0])
-    n /= np.maximum(np.linalg.norm(n, axis=1), np.finfo(float).tiny)[:, None]
+    n /= np.maximum(np.linalg.norm(n, axis=1), DIVISION_GUARD)[:, None]
     lam = ambient + (1.0 - ambient) * np.abs(n @ light)
     return np.clip(np.asarray(base, dtype=np.float64).reshape(-1, 3) * lam[:, None], 0, 1)
 
@@ -516,7 +517,7 @@ def _frame(ax, lo, hi, elev, azim):
     """Equal aspect around the data's bounding box, axes hidden, camera set."""
     centre = 0.5 * (lo + hi)
     ext = hi - lo
-    big = max(float(ext.max()), 1e-12)
+    big = max(float(ext.max()), ZERO_LENGTH)
     ext = np.maximum(ext, 0.02 * big)  # flat data keeps a thin box
     ax.set_xlim(centre[0] - ext[0] / 2, centre[0] + ext[0] / 2)
     ax.set_ylim(centre[1] - ext[1] / 2, centre[1] + ext[1] / 2)

@@ -15,6 +15,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .core.geometry import arc_length, interpolate_polyline, resample_polyline
+from .core.tolerances import DIVISION_GUARD
 from .errors import InvalidParameterError
 from .network import CurveNetwork
 from .sketch import Sketch
@@ -36,7 +37,7 @@ def _wobble(rng, n, amplitude):
         amp = rng.normal(size=4) / k[0]
         out[:, ax] = (amp[None, :] * np.sin(np.pi * k * t + ph[None, :])).sum(axis=1)
     peak = np.linalg.norm(out, axis=1).max()
-    return out * (amplitude / max(peak, 1e-300))
+    return out * (amplitude / max(peak, DIVISION_GUARD))
 
 
 def _stroke(rng, curve, s0, s1, diag, wobble, spacing):

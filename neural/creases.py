@@ -47,6 +47,7 @@ from scipy.spatial import cKDTree
 
 from curvenet.core.geometry import arc_length, face_normals_areas, resample_polyline, sample_surface
 from curvenet.core.strokes import check_strokes
+from curvenet.core.tolerances import NORM_EPS, ZERO_LENGTH
 
 from .presets import CREASE_PRESETS, CreaseConfig, crease_config
 from .training import Stage, Step, seeded, torch_device, train
@@ -71,7 +72,7 @@ GUIDE_LAMBDA = 0.5
 # ---------------------------------------------------------------------------------------------
 # guiding directions and strips (Appendix A)
 # ---------------------------------------------------------------------------------------------
-def _unit(v, eps=1e-12):
+def _unit(v, eps=NORM_EPS):
     v = np.asarray(v, dtype=np.float64)
     return v / np.maximum(np.linalg.norm(v, axis=-1, keepdims=True), eps)
 
@@ -502,7 +503,7 @@ def _unit_frame(v, strokes, labels):
     used = [s for s, lb in zip(strokes, labels) if lb != "construction"]
     allp = np.concatenate([v] + used) if used else v
     lo, hi = allp.min(0), allp.max(0)
-    return 0.5 * (lo + hi), max(float((hi - lo).max()) / 1.6, 1e-12)
+    return 0.5 * (lo + hi), max(float((hi - lo).max()) / 1.6, ZERO_LENGTH)
 
 
 def _crease_features(cfg: CreaseConfig, creases, vu, f):

@@ -35,6 +35,8 @@ import numpy as np
 import torch
 from scipy.spatial import cKDTree
 
+from curvenet.core.tolerances import DIVISION_GUARD, TINY_F32
+
 __all__ = [
     "segment_integral",
     "triangle_integral",
@@ -45,7 +47,7 @@ __all__ = [
 ]
 
 #: Guard below which squared lengths are treated as zero (query point on a vertex / edge line).
-_TINY2 = 1e-30
+_TINY2 = TINY_F32
 #: ``I_n`` of the mollifier (Sec. 3.2.3: "set to 1/e"), so that phi(0) = 1.
 MOLLIFIER_I_N = 1.0 / math.e
 #: Default bound on (query points x elements) pairs evaluated at once by the global version.
@@ -151,7 +153,7 @@ def triangle_integral(x: torch.Tensor, v0: torch.Tensor, v1: torch.Tensor,
         pos = (lp + lm) >= 0
         num = torch.where(pos, rp + lp, rm - lm)
         den = torch.where(pos, rm + lm, rp - lp)
-        ok = (num > 1e-300) & (den > 1e-300)
+        ok = (num > DIVISION_GUARD) & (den > DIVISION_GUARD)
         one = torch.ones_like(num)
         logt = torch.where(ok, torch.log(torch.where(ok, num, one))
                            - torch.log(torch.where(ok, den, one)), torch.zeros_like(num))

@@ -73,6 +73,7 @@ import numpy as np
 
 from curvenet.core.geometry import face_normals_areas, sample_surface
 from curvenet.core.strokes import check_strokes
+from curvenet.core.tolerances import COINCIDENT_REL, NORM_EPS, TINY_F32
 
 from .presets import FlowConfig, get_config
 from .training import Stage, Step, seeded, torch_device, train
@@ -223,9 +224,9 @@ def sample_surface_cells(f_grid, n: int, gen, *, newton_steps: int = 2):
     h = 1.0 / res
     for _ in range(newton_steps):
         v, gr = interpolate(f5[0, 0], p, with_gradient=True)
-        step = (v / (gr * gr).sum(-1).clamp(min=1e-12)).unsqueeze(-1) * gr
+        step = (v / (gr * gr).sum(-1).clamp(min=NORM_EPS)).unsqueeze(-1) * gr
         norm = step.norm(dim=-1, keepdim=True)
-        step = step * torch.clamp(h / norm.clamp(min=1e-30), max=1.0)
+        step = step * torch.clamp(h / norm.clamp(min=TINY_F32), max=1.0)
         p = p - step
     return p.clamp(0.0, 1.0)
 
@@ -267,8 +268,8 @@ def _prefit_targets(init_mesh, frame: Frame, sigma, rng, n=20000):
     S, _, C, N = igl.signed_distance(P, V, F, sign_type=igl.SIGNED_DISTANCE_TYPE_PSEUDONORMAL)
     d = P - C
     dn = np.linalg.norm(d, axis=1, keepdims=True)
-    grad = np.where(dn > 1e-9, d / np.maximum(dn, 1e-12) * np.sign(S)[:, None], N)
-    grad /= np.maximum(np.linalg.norm(grad, axis=1, keepdims=True), 1e-12)
+    grad = np.where(dn > COINCIDENT_REL, d / np.maximum(dn, NORM_EPS) * np.sign(S)[:, None], N)
+    grad /= np.maximum(np.linalg.norm(grad, axis=1, keepdims=True), NORM_EPS)
     return P, sigma * grad, surf
 
 
@@ -382,7 +383,7 @@ class _FlowFit:
             x = torch.cat([torch.rand(n, 3, generator=gen, device=dev, dtype=dtype),
                            self.sampler.sample(n, gen)[0]])
             d = x - c
-            target = cfg.sigma * d / d.norm(dim=-1, keepdim=True).clamp(min=1e-6)
+            target = cfg.sigma * d / d.norm(dim=-1, keepdim=True).clamp(min=1e-6)  # local: x = c
             return Step(((self.net(x) - target) ** 2).sum(-1).mean())
 
         return Stage("geometric", cfg.geometric_init_steps, step)

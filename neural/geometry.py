@@ -25,11 +25,13 @@ from __future__ import annotations
 
 import torch
 
+from curvenet.core.tolerances import NORM_EPS
+
 __all__ = ["EPS", "tangent_frame", "second_fundamental_form", "principal_curvatures",
            "alignment_cos4", "directional_derivative_II", "covariant_tv", "curl"]
 
 #: Guard for divisions by |g|, by |t_uv|^2 and by the anisotropy of II (unit-cube units).
-EPS = 1e-12
+EPS = NORM_EPS
 
 
 def tangent_frame(n: torch.Tensor):
@@ -167,7 +169,7 @@ def directional_derivative_II(g, G, H, d):
     return (dP @ Gs @ P + P @ dGs @ P + P @ Gs @ dP) / nrm - II * dnorm / nrm
 
 
-def covariant_tv(g, G, H, *, eps: float = 1e-12):
+def covariant_tv(g, G, H, *, eps: float = EPS):
     """Pointwise ``|| nabla_S II ||_F`` (Eq. 5, 18).
 
     The covariant derivative of the tangential tensor field II on the level set

@@ -16,6 +16,8 @@ from __future__ import annotations
 
 import torch
 
+from curvenet.core.tolerances import NORM_EPS
+
 from .geometry import alignment_cos4, covariant_tv, curl, second_fundamental_form, tangent_frame
 
 __all__ = ["alignment_loss", "smoothness_loss", "smoothness_loss_autograd", "data_loss",
@@ -43,7 +45,7 @@ def smoothness_loss(g, G, H):
     return covariant_tv(g, G, H).mean()
 
 
-def smoothness_loss_autograd(net, x, *, eps: float = 1e-12):
+def smoothness_loss_autograd(net, x, *, eps: float = NORM_EPS):
     """Eq. 5 by double backward instead of the closed-form jet (same value).
 
     ``II`` is built from ``net.jet(x, order=1)`` and differentiated with
@@ -60,7 +62,7 @@ def smoothness_loss_autograd(net, x, *, eps: float = 1e-12):
             grads[i, j] = torch.autograd.grad(II[:, i, j].sum(), x, create_graph=True)[0]
     D = torch.stack([torch.stack([grads[min(i, j), max(i, j)] for j in range(3)], 1)
                      for i in range(3)], 1)                       # (N, 3, 3, 3): d II_ij / d x_k
-    n = g / g.norm(dim=-1, keepdim=True).clamp(min=1e-12)
+    n = g / g.norm(dim=-1, keepdim=True).clamp(min=NORM_EPS)
     P = torch.eye(3, dtype=g.dtype, device=g.device) - n.unsqueeze(-1) * n.unsqueeze(-2)
     t1, t2 = tangent_frame(n)
     total = 0.0

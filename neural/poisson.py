@@ -25,6 +25,8 @@ import math
 
 import torch
 
+from curvenet.core.tolerances import NORM_EPS, TINY_F32
+
 __all__ = ["PoissonSolver", "splat", "normalize_splat", "interpolate", "normalize_scale_shift",
            "trilinear_stencil"]
 
@@ -132,7 +134,8 @@ def interpolate(grid: torch.Tensor, points: torch.Tensor, *, with_gradient: bool
     return out, torch.stack(grads, -1)
 
 
-def normalize_scale_shift(f_grid: torch.Tensor, f_strokes: torch.Tensor, *, eps: float = 1e-12):
+def normalize_scale_shift(f_grid: torch.Tensor, f_strokes: torch.Tensor, *,
+                         eps: float = NORM_EPS):
     """Scale-and-shift normalisation of Eq. 11.
 
     ``f <- (f - mean_strokes f) / |f(corner) - mean_strokes f|``: the stroke
@@ -218,7 +221,7 @@ class PoissonSolver:
         uu = (torch.fft.fftfreq(n, d=1.0 / n, dtype=torch.float64) ** 2).view(n, 1, 1) \
             + (torch.fft.fftfreq(n, d=1.0 / n, dtype=torch.float64) ** 2).view(1, n, 1) \
             + (torch.fft.rfftfreq(n, d=1.0 / n, dtype=torch.float64) ** 2).view(1, 1, -1)
-        inv = torch.where(uu > 0, 1.0 / (-2.0 * math.pi * uu.clamp(min=1e-30)),
+        inv = torch.where(uu > 0, 1.0 / (-2.0 * math.pi * uu.clamp(min=TINY_F32)),
                           torch.zeros_like(uu))
         if smooth_cells > 0:
             s = smooth_cells / n

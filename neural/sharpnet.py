@@ -28,6 +28,8 @@ import numpy as np
 import torch
 from torch import nn
 
+from curvenet.core.tolerances import NORM_EPS
+
 from .feature import feature_function, mollified_feature_function
 
 __all__ = [
@@ -160,7 +162,7 @@ def smoothness_regulariser(vertices: torch.Tensor, triples, lam: float = LR_LAMB
     al, a, ar = vertices[tr[:, 0]], vertices[tr[:, 1]], vertices[tr[:, 2]]
     v = 0.5 * (al + ar) - a
     chord = ar - al
-    u = chord / chord.norm(dim=-1, keepdim=True).clamp_min(1e-12)
+    u = chord / chord.norm(dim=-1, keepdim=True).clamp_min(NORM_EPS)
     vn = torch.sqrt((v * v).sum(-1) + 1e-24)
     return lam * vn.mean() + (1.0 - lam) * (v * u).sum(-1).abs().mean()
 

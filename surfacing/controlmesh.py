@@ -50,6 +50,7 @@ from scipy.spatial import cKDTree
 
 from .coons import coons_eval, coons_grid
 from curvenet.core.geometry import resample_polyline
+from curvenet.core.tolerances import DIVISION_GUARD
 from .sides import DEFAULT_STRAIGHT_ANGLE, group_sides
 
 __all__ = ["ControlMesh", "build_control_mesh", "orient_loops", "curve_pieces", "JUNCTION_TOL"]
@@ -79,9 +80,9 @@ def curve_pieces(curves: list, closed: np.ndarray) -> np.ndarray:
     turn = np.empty(len(curves))
     for i, c in enumerate(curves):
         d = np.diff(resample_polyline(c, 32), axis=0)
-        d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-300)
+        d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), DIVISION_GUARD)
         turn[i] = np.degrees(np.arccos(np.clip((d[1:] * d[:-1]).sum(1), -1, 1))).sum()
-    m = np.maximum(np.ceil(lengths / (PIECE_LENGTH * max(med, 1e-300))),
+    m = np.maximum(np.ceil(lengths / (PIECE_LENGTH * max(med, DIVISION_GUARD))),
                    np.ceil(turn / PIECE_TURN))
     m = np.maximum(m, 1).astype(np.int64)
     return np.where(closed, np.maximum(m, 2), m)
@@ -178,7 +179,7 @@ def _junctions(curves, loops, diag):
     C = len(curves)
     ends = np.concatenate([np.stack([c[0], c[-1]]) for c in curves])   # (2C, 3): 2i start
     tree = cKDTree(ends)
-    pairs = tree.query_pairs(JUNCTION_TOL * max(diag, 1e-300), output_type="ndarray")
+    pairs = tree.query_pairs(JUNCTION_TOL * max(diag, DIVISION_GUARD), output_type="ndarray")
     extra = []
     for lp in loops:              # consecutive curves in a loop share the junction between them
         n = len(lp)

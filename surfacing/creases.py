@@ -24,6 +24,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from curvenet.core.tolerances import DIVISION_GUARD
+
 from .controlmesh import ControlMesh
 from .polyline import end_tangents
 
@@ -52,7 +54,7 @@ def _patch_vertex_normals(cm: ControlMesh):
     uk, inv = np.unique(keys, return_inverse=True)
     acc = np.zeros((len(uk), 3))
     np.add.at(acc, inv, vals)
-    acc /= np.maximum(np.linalg.norm(acc, axis=1, keepdims=True), 1e-300)
+    acc /= np.maximum(np.linalg.norm(acc, axis=1, keepdims=True), DIVISION_GUARD)
 
     def lookup(patch: int, vertex: int) -> np.ndarray:
         k = patch * n + vertex

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from curvenet.core.tolerances import DIVISION_GUARD, DUPLICATE_POINT_REL
+
 __all__ = ["fit_cubic_curve"]
 
 
@@ -38,7 +40,7 @@ def fit_cubic_curve(points: np.ndarray, n_out: int, smoothing: float = 0.0) -> n
     if n_out < 2:
         raise ValueError(f"n_out: expected >= 2, got {n_out}")
     d = np.linalg.norm(np.diff(P, axis=0), axis=1)
-    keep = np.concatenate([[True], d > 1e-12 * max(d.sum(), 1e-300)])
+    keep = np.concatenate([[True], d > DUPLICATE_POINT_REL * max(d.sum(), DIVISION_GUARD)])
     P = P[keep]
     if len(P) < 4:
         t = np.linspace(0, 1, n_out)[:, None]

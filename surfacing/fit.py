@@ -27,6 +27,8 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from curvenet.core.tolerances import DIVISION_GUARD
+
 from .catmull_clark import CORNER, CREASE, edge_topology, sharp_mask, vertex_classes
 from .limit import limit_normals
 
@@ -129,7 +131,7 @@ def fit_lsq(L, F, P0, constrained, targets, *, curve_weight: float | None = None
     n = len(P0)
     A = L[constrained]
     H = (F.T @ F).tocsr()
-    reg = _TIKHONOV * max(H.diagonal().mean(), 1e-300)
+    reg = _TIKHONOV * max(H.diagonal().mean(), DIVISION_GUARD)
     H = H + reg * sp.identity(n, format="csr")
     rhs0 = reg * P0
     if extra is not None:
@@ -182,7 +184,7 @@ def vspring_displacement(Q, N, edges, smooth=None) -> np.ndarray:
     i, j = e[:, 0], e[:, 1]
     d = Q[j] - Q[i]
     ln = np.linalg.norm(d, axis=1)
-    w = 1.0 / np.maximum(ln, 1e-300)
+    w = 1.0 / np.maximum(ln, DIVISION_GUARD)
     Nj = N[j]
     if smooth is not None:
         # across a crease the neighbour's normal belongs to the other sheet: use n_i
@@ -198,7 +200,7 @@ def vspring_displacement(Q, N, edges, smooth=None) -> np.ndarray:
     np.add.at(lap, i, d)
     lap /= np.maximum(cnt, 1)[:, None]
     reg = lap - np.einsum("ij,ij->i", lap, N)[:, None] * N
-    return num / np.maximum(wsum, 1e-300)[:, None] + reg
+    return num / np.maximum(wsum, DIVISION_GUARD)[:, None] + reg
 
 
 def fit_iterative(L, T1, T2, has_tangent, quads, P0, constrained, targets, *,

@@ -32,6 +32,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 
+from curvenet.core.tolerances import DIVISION_GUARD
+
 from .catmull_clark import (CREASE, SMOOTH, crease_neighbours, edge_topology, sharp_mask,
                             vertex_classes)
 
@@ -198,7 +200,7 @@ def quad_vertex_normals(vertices: np.ndarray, quads: np.ndarray) -> np.ndarray:
     for k in range(4):
         np.add.at(N, q[:, k], fn)
     ln = np.linalg.norm(N, axis=1, keepdims=True)
-    return N / np.maximum(ln, 1e-300)
+    return N / np.maximum(ln, DIVISION_GUARD)
 
 
 def limit_normals(P, quads, T1, T2, has_tangent, L=None) -> np.ndarray:
@@ -214,7 +216,7 @@ def limit_normals(P, quads, T1, T2, has_tangent, L=None) -> np.ndarray:
     P = np.asarray(P, dtype=np.float64)
     N = np.cross(T1 @ P, T2 @ P)
     ln = np.linalg.norm(N, axis=1, keepdims=True)
-    N = N / np.maximum(ln, 1e-300)
+    N = N / np.maximum(ln, DIVISION_GUARD)
     fallback = ~has_tangent | (ln[:, 0] <= 0)
     if fallback.any():
         Q = P if L is None else L @ P

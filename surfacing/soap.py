@@ -23,6 +23,7 @@ import scipy.sparse.linalg as spla
 from scipy.spatial import Delaunay
 
 from curvenet.core.geometry import arc_length_params, resample_polyline
+from curvenet.core.tolerances import COINCIDENT_REL, DEGENERATE_AREA_REL, DIVISION_GUARD
 
 __all__ = ["disk_triangulation", "soapfilm_patch", "soapfilm_mesh"]
 
@@ -58,7 +59,7 @@ def disk_triangulation(n_boundary: int, t: np.ndarray | None = None):
     a, b, c = uv[tri[:, 0]], uv[tri[:, 1]], uv[tri[:, 2]]
     area = (b[:, 0] - a[:, 0]) * (c[:, 1] - a[:, 1]) - (b[:, 1] - a[:, 1]) * (c[:, 0] - a[:, 0])
     tri[area < 0] = tri[area < 0][:, [0, 2, 1]]
-    tri = tri[np.abs(area) > 1e-14]
+    tri = tri[np.abs(area) > DEGENERATE_AREA_REL]  # the unit disk: scale 1
     return uv, tri
 
 
@@ -70,7 +71,7 @@ def _cotan_laplacian(uv: np.ndarray, faces: np.ndarray) -> sp.csr_matrix:
         i, j, o = faces[:, (k + 1) % 3], faces[:, (k + 2) % 3], faces[:, k]
         u, v = uv[i] - uv[o], uv[j] - uv[o]
         cross = np.abs(u[:, 0] * v[:, 1] - u[:, 1] * v[:, 0])
-        cot = np.einsum("ij,ij->i", u, v) / np.maximum(cross, 1e-300)
+        cot = np.einsum("ij,ij->i", u, v) / np.maximum(cross, DIVISION_GUARD)
         w = 0.5 * cot
         rows += [i, j, i, j]
         cols += [j, i, i, j]
@@ -159,7 +160,7 @@ def soapfilm_mesh(curves, loops, *, resolution: int = 16):
     F = np.concatenate(Fs)
     # weld identical curve samples (same resampling on both sides of a shared curve)
     diag = float(np.linalg.norm(V.max(0) - V.min(0))) or 1.0
-    key = np.round(V / (diag * 1e-9)).astype(np.int64)
+    key = np.round(V / (diag * COINCIDENT_REL)).astype(np.int64)
     _, first, inv = np.unique(key, axis=0, return_index=True, return_inverse=True)
     inv = inv.ravel()
     return V[first], inv[F], np.concatenate(P)

@@ -19,7 +19,7 @@ import numpy as np
 
 from curvenet.errors import InvalidParameterError
 
-from .tolerances import ZERO_LENGTH
+from .tolerances import DIVISION_GUARD, ZERO_LENGTH
 
 __all__ = [
     "as_polyline",
@@ -269,7 +269,7 @@ def face_normals_areas(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndar
     tri = np.asarray(vertices, dtype=np.float64)[np.asarray(faces)]       # (F, 3, 3)
     cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])        # (F, 3)
     norm = np.linalg.norm(cross, axis=1)
-    normals = cross / np.maximum(norm, np.finfo(float).tiny)[:, None]    # guard: zero area
+    normals = cross / np.maximum(norm, DIVISION_GUARD)[:, None]           # zero area
     return normals, 0.5 * norm
 
 

@@ -48,9 +48,9 @@ DIVISION_GUARD = 1e-300
 #: ``sqrt(1e-30) = 1e-15`` and keeps the gradient of ``sqrt`` finite at 0.
 TINY_F32 = 1e-30
 
-#: Floor of a vector norm before it is normalised, in unit-cube or normalised
-#: coordinates (gradients of an implicit field, tangents, face normals): a smaller
-#: vector yields a small vector instead of NaN.
+#: Floor of a vector norm (or squared norm) before dividing by it, in unit-cube or
+#: normalised coordinates, numpy or torch (gradients of an implicit field, Newton steps,
+#: tangents, chords): a smaller vector yields a small vector instead of NaN.
 NORM_EPS = 1e-12
 
 #: Length (input units) at or under which a whole polyline counts as zero-length: its
