@@ -46,6 +46,7 @@ from scipy import sparse
 from scipy.sparse import csgraph
 from scipy.spatial import cKDTree
 
+from .core.geometry import cumulative_length, interpolate_polyline
 from .core.tolerances import DIVISION_GUARD
 from .errors import InvalidParameterError, SketchFormatError
 from .sketch import Sketch
@@ -390,7 +391,7 @@ def _prune(x, e, c, forks=False):
 def _end_line(x, nodes, c):
     """Mean and direction of a chain's nodes between ``c`` and ``6 c`` from its first node."""
     p = x[nodes]
-    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(p, axis=0), axis=1))])
+    s = cumulative_length(p)
     sel = p[(s >= c) & (s <= 6 * c)]
     if len(sel) < 2:
         return None
@@ -462,13 +463,13 @@ def _corners(poly, w):
     over ``[2 w / 3, 2 w]``: a corner's turn does not grow with the window
     (rounding by the sampling scale aside), a smooth bend's grows in proportion.
     """
-    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(poly, axis=0), axis=1))])
+    s = cumulative_length(poly)
     inside = np.flatnonzero((s > 2 * w) & (s < s[-1] - 2 * w))
     if len(inside) == 0:
         return inside
 
     def at(t):
-        return np.column_stack([np.interp(t, s, poly[:, k]) for k in range(3)])
+        return interpolate_polyline(poly, t, cum=s)
 
     def turn(r):
         u, v = at(s[inside] - r / 3) - at(s[inside] - r), at(s[inside] + r) - at(s[inside] + r / 3)
@@ -683,12 +684,12 @@ def sample_curves(curves, spacing: float, *, noise: float = 0.0, uneven: float =
     out = []
     for cv in curves:  # loop over curves; samples are vectorised
         cv = np.asarray(cv, dtype=np.float64)
-        s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(cv, axis=0), axis=1))])
+        s = cumulative_length(cv)
         n = max(2, int(round(s[-1] / spacing)))
         u = (np.arange(n) + rng.uniform()) / n
         phase = rng.uniform(0, 2 * np.pi)
         t = u + a * (np.sin(2 * np.pi * u + phase) - np.sin(phase)) / (2 * np.pi)
-        out.append(np.column_stack([np.interp(t * s[-1], s, cv[:, k]) for k in range(3)]))
+        out.append(interpolate_polyline(cv, t * s[-1], cum=s))
     pts = np.concatenate(out)
     pts = pts + rng.normal(0.0, noise / np.sqrt(3.0), pts.shape) if noise > 0 else pts
     return rng.permutation(pts)
