@@ -40,12 +40,13 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict
 
 import numpy as np
 from scipy.spatial import cKDTree
 
 from curvenet.core.geometry import arc_length, face_normals_areas, resample_polyline, sample_surface
+from curvenet.core.result import MeshResult
 from curvenet.core.strokes import check_strokes
 from curvenet.core.tolerances import NORM_EPS, ZERO_LENGTH
 
@@ -55,7 +56,6 @@ from .training import Stage, Step, seeded, torch_device, train
 __all__ = [
     "CreaseConfig",
     "crease_config",
-    "CreaseResult",
     "CREASE_PRESETS",
     "guide_directions",
     "stroke_guides_from_mesh",
@@ -345,24 +345,6 @@ def crease_feature_set(strokes, vertices, faces, *, width: float, spacing: float
 # ---------------------------------------------------------------------------------------------
 # crease refinement
 # ---------------------------------------------------------------------------------------------
-@dataclass
-class CreaseResult:
-    """Output of :func:`crease_refine`.
-
-    Attributes
-    ----------
-    vertices : (V, 3) float64, world coordinates
-    faces : (F, 3) int64, oriented along grad Phi (outwards for a closed input)
-    report : dict
-        ``timings`` (seconds: ``setup``, ``train``, ``extract``), ``n_strip_triangles``,
-        ``n_channels``, ``final_loss``, ``config``, ``interrupted``, ``seed``, ``device``.
-    """
-
-    vertices: np.ndarray
-    faces: np.ndarray
-    report: dict
-
-
 def _sample_mesh(v, f, n, rng):
     """``n`` area-uniform points ``(n, 3)`` on the mesh and the unit normals of their faces."""
     normals, areas = face_normals_areas(v, f)
@@ -384,7 +366,7 @@ def _check_inputs(vertices, faces, strokes, labels):
 
 def crease_refine(vertices, faces, strokes, labels=None, *, quality: str = "draft",
                   device="cpu", seed: int = 0, progress: bool = True, **overrides
-                  ) -> CreaseResult:
+                  ) -> MeshResult:
     """Refit a surface as a SharpNet SDF with true creases along the crease strokes.
 
     Parameters
@@ -411,8 +393,10 @@ def crease_refine(vertices, faces, strokes, labels=None, *, quality: str = "draf
 
     Returns
     -------
-    CreaseResult
-        The marching-cubes zero set of the fitted SDF in world coordinates.
+    MeshResult
+        The marching-cubes zero set of the fitted SDF in world coordinates; ``report`` has
+        ``timings`` (seconds: ``setup``, ``train``, ``extract``), ``n_strip_triangles``,
+        ``n_channels``, ``final_loss``, ``config``, ``interrupted``, ``seed``, ``device``.
 
     Raises
     ------
@@ -495,7 +479,7 @@ def crease_refine(vertices, faces, strokes, labels=None, *, quality: str = "draf
         "config": asdict(cfg),
         "frame": {"centre": centre.tolist(), "scale": scale},
     }
-    return CreaseResult(mv_ * scale + centre, mf_, report)
+    return MeshResult(mv_ * scale + centre, mf_, report)
 
 
 def _unit_frame(v, strokes, labels):

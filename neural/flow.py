@@ -72,6 +72,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from curvenet.core.geometry import face_normals_areas, sample_surface
+from curvenet.core.result import MeshResult
 from curvenet.core.strokes import check_strokes
 from curvenet.core.tolerances import COINCIDENT_REL, NORM_EPS, TINY_F32
 
@@ -113,14 +114,16 @@ class Frame:
         return np.asarray(u, float) * self.side + self.box_min
 
 
-@dataclass
-class FlowResult:
-    """Output of :func:`fit_flow_surface`.
+@dataclass(repr=False, kw_only=True)
+class FlowResult(MeshResult):
+    """Output of :func:`fit_flow_surface`: a :class:`~curvenet.core.MeshResult` and its field.
 
     Attributes
     ----------
     vertices : (V, 3) float64, world coordinates
     faces : (F, 3) int64, oriented along grad f (outwards for f > 0 outside)
+    report : dict, ``steps`` done per stage, ``interrupted``, ``device``,
+        ``seed``, ``quality``, ``config``, mesh stats
     f_grid : (n, n, n) float32, normalised f (Eq. 11) at the grid nodes, signed so
         that the box corner (outside) is +1
     origin : (3,) float64, world position of node ``[0, 0, 0]``
@@ -129,18 +132,13 @@ class FlowResult:
         ``extract``, ``total``)
     history : dict, stage -> term -> list of per-step values
         (terms ``total, align, smooth, data, eik, curl``; unweighted)
-    report : dict, ``steps`` done per stage, ``interrupted``, ``device``,
-        ``seed``, ``quality``, ``config``, mesh stats
     """
 
-    vertices: np.ndarray
-    faces: np.ndarray
     f_grid: np.ndarray
     origin: np.ndarray
     spacing: float
     timings: dict = field(default_factory=dict)
     history: dict = field(default_factory=dict)
-    report: dict = field(default_factory=dict)
 
     def f(self, points: np.ndarray) -> np.ndarray:
         """Trilinear f at world points (M, 3) -> (M,) (periodic outside the box)."""
@@ -151,11 +149,6 @@ class FlowResult:
         u = (np.asarray(points, float) - self.origin) / (self.spacing * n) + 0.5 / n
         return interpolate(torch.from_numpy(self.f_grid.astype(np.float64)),
                            torch.from_numpy(u)).numpy()
-
-    def mesh(self):
-        """The surface as a ``trimesh.Trimesh`` (not processed)."""
-        import trimesh
-        return trimesh.Trimesh(self.vertices, self.faces, process=False)
 
 
 class StrokeSampler:
@@ -554,7 +547,8 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
               "quality": quality, "config": cfg.as_dict(), "n_vertices": len(V),
               "n_faces": len(F), "cut_faces": n_cut,
               "stroke_length_unit": fit.sampler.total_length}
-    return FlowResult(V, F, f_np, origin, h_world, timings, fit.history, report)
+    return FlowResult(V, F, report, f_grid=f_np, origin=origin, spacing=h_world, timings=timings,
+                      history=fit.history)
 
 
 def _extract(f_final, frame: Frame, strokes, labels, cut_boundary):

@@ -7,8 +7,8 @@ mesh -> limit surface fitted to the curves, with creases) and
 :func:`soapfilm_loops` (the soap-film baseline).
 """
 
-from .api import (DEFAULT_RESOLUTION, DEFAULT_SUBDIV, SurfaceResult, soapfilm_loops,
-                  surface_loops)
+from .api import (DEFAULT_RESOLUTION, DEFAULT_SUBDIV, PatchMeshResult, check_loops_options,
+                  soapfilm_loops, surface_loops)
 from .catmull_clark import euler_characteristic, subdivide, subdivision_step
 from .coons import coons_eval, coons_grid
 from .controlmesh import ControlMesh, build_control_mesh
@@ -17,7 +17,8 @@ from .sides import group_sides
 from .soap import soapfilm_patch
 
 __all__ = [
-    "DEFAULT_RESOLUTION", "DEFAULT_SUBDIV", "SurfaceResult", "surface_loops", "soapfilm_loops",
+    "DEFAULT_RESOLUTION", "DEFAULT_SUBDIV", "PatchMeshResult", "check_loops_options",
+    "surface_loops", "soapfilm_loops",
     "soapfilm", "euler_characteristic", "subdivide", "subdivision_step", "coons_grid",
     "coons_eval", "ControlMesh", "build_control_mesh", "limit_matrix", "tangent_matrices",
     "group_sides", "soapfilm_patch",

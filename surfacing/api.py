@@ -8,9 +8,12 @@ with creases, n-sided loops and a direct least-squares fit added;
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
+
+from curvenet.core.result import MeshResult
+from curvenet.errors import InvalidParameterError
 
 from .catmull_clark import edge_index, subdivision_step
 from .controlmesh import build_control_mesh
@@ -23,8 +26,8 @@ from .polyline import point_polyline_distance
 from .sides import DEFAULT_STRAIGHT_ANGLE
 from .soap import soapfilm_mesh
 
-__all__ = ["SurfaceResult", "surface_loops", "soapfilm_loops", "DEFAULT_RESOLUTION",
-           "DEFAULT_SUBDIV", "DEFAULT_TOL"]
+__all__ = ["PatchMeshResult", "surface_loops", "soapfilm_loops", "check_loops_options",
+           "DEFAULT_RESOLUTION", "DEFAULT_SUBDIV", "DEFAULT_TOL"]
 
 #: Control-polygon segments per curve (the paper's user-set N).
 DEFAULT_RESOLUTION = 4
@@ -34,9 +37,9 @@ DEFAULT_SUBDIV = 3
 DEFAULT_TOL = 1e-4
 
 
-@dataclass
-class SurfaceResult:
-    """A surfaced patch set.
+@dataclass(repr=False, kw_only=True)
+class PatchMeshResult(MeshResult):
+    """A surfaced patch set: a :class:`~curvenet.core.MeshResult` with per-patch extras.
 
     Attributes
     ----------
@@ -44,8 +47,6 @@ class SurfaceResult:
         Limit-surface points (subdivided ``subdiv`` times, then pushed to the limit).
     faces : (f, 3) int64
         Triangles, two per limit quad, oriented like the loops.
-    face_patch : (f,) int64
-        Loop index of each triangle.
     report : dict
         ``max_curve_deviation`` / ``mean_curve_deviation`` (limit points along the
         curves to the input polylines, fraction of the diagonal),
@@ -53,16 +54,15 @@ class SurfaceResult:
         ``timings`` (seconds), ``creases`` (crease curves), ``creases_detected``
         (made creases by the dihedral test), ``n_patches``, ``n_control_vertices``,
         ``patch_kinds``, ``fit``.
+    face_patch : (f,) int64
+        Loop index of each triangle.
     curves : list of (m_i, 3) float64 or None
         Updated network curves when ``update_curves`` was asked for.
     control_vertices, control_quads : arrays or None
         The fitted control mesh (classical route only).
     """
 
-    vertices: np.ndarray
-    faces: np.ndarray
     face_patch: np.ndarray
-    report: dict = field(default_factory=dict)
     curves: list | None = None
     control_vertices: np.ndarray | None = None
     control_quads: np.ndarray | None = None
@@ -76,6 +76,42 @@ def _quads_to_tris(q: np.ndarray) -> np.ndarray:
 MAX_OUTPUT_FACES = 20_000_000
 
 
+def check_loops_options(*, resolution=DEFAULT_RESOLUTION, subdiv=DEFAULT_SUBDIV, fit="lsq",
+                        straight_angle=DEFAULT_STRAIGHT_ANGLE, tol=DEFAULT_TOL, lam=LAMBDA,
+                        curve_weight=None, fairness="variation", n_loops: int = 1,
+                        **_other) -> None:
+    """Check the scalar options of :func:`surface_loops` before any work.
+
+    Takes the keyword options of :func:`surface_loops` (others are ignored) and the
+    number of loops, ``n_loops`` (1 when not known yet: the size check is then a
+    weaker lower bound).
+
+    Raises
+    ------
+    InvalidParameterError
+        The first option out of range, the message naming it and its value; or an
+        output that would exceed :data:`MAX_OUTPUT_FACES` triangles.
+    """
+    checks = [
+        ("fit", fit, lambda v: v in ("lsq", "iterative"), "'lsq' or 'iterative'"),
+        ("subdiv", subdiv, lambda v: _is_int(v) and v >= 0, "an integer >= 0"),
+        ("resolution", resolution, lambda v: _is_int(v) and v >= 2, "an integer >= 2"),
+        ("fairness", fairness, lambda v: v in FAIRNESS, f"one of {FAIRNESS}"),
+        ("tol", tol, lambda v: v > 0, "> 0"),
+        ("lam", lam, lambda v: 0 < v <= 1, "in (0, 1]"),
+        ("curve_weight", curve_weight, lambda v: v is None or v > 0, "> 0 or None"),
+        ("straight_angle", straight_angle, lambda v: 0 <= v < 180, "degrees in [0, 180)"),
+    ]
+    for name, value, ok, expected in checks:
+        try:
+            good = bool(ok(value))
+        except (TypeError, ValueError):     # not a number at all
+            good = False
+        if not good:
+            raise InvalidParameterError(f"{name}: expected {expected}, got {value!r}")
+    _check_output_size(n_loops, resolution, int(subdiv))
+
+
 def _check_output_size(n_loops: int, resolution: int, subdiv: int) -> None:
     """Refuse settings whose output would not fit in memory, before building anything.
 
@@ -85,19 +121,23 @@ def _check_output_size(n_loops: int, resolution: int, subdiv: int) -> None:
     r = int(resolution) + int(resolution) % 2
     faces = 2 * max(n_loops, 1) * r * r * 4 ** subdiv
     if faces > MAX_OUTPUT_FACES:
-        raise ValueError(f"resolution {resolution} with subdiv {subdiv} would write at least "
-                         f"{faces:.3g} triangles for {n_loops} patches; the limit is "
-                         f"{MAX_OUTPUT_FACES:.3g} (lower --resolution or --subdiv)")
+        raise InvalidParameterError(
+            f"resolution {resolution} with subdiv {subdiv} would write at least {faces:.3g} "
+            f"triangles for {n_loops} patches; the limit is {MAX_OUTPUT_FACES:.3g} "
+            "(lower --resolution or --subdiv)")
+
+
+def _is_int(value) -> bool:
+    return not isinstance(value, bool) and int(value) == value
 
 
 def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None =
                   DEFAULT_CREASE_ANGLE, resolution: int = DEFAULT_RESOLUTION,
                   subdiv: int = DEFAULT_SUBDIV, fit: str = "lsq", update_curves=False,
                   straight_angle: float = DEFAULT_STRAIGHT_ANGLE, tol: float = DEFAULT_TOL,
-                  max_iter: int = 500, lam: float = LAMBDA,
-                  curve_weight: float | None = None,
-                  fairness: str = "variation",
-                  vspring_step: float = VSPRING_STEP) -> SurfaceResult:
+                  max_iter: int = 500, lam: float = LAMBDA, curve_weight: float | None = None,
+                  fairness: str = "variation", vspring_step: float = VSPRING_STEP
+                  ) -> PatchMeshResult:
     """Smooth surface through a curve network's loops (Orbay & Kara 2011, Sec. 4.2-4.3).
 
     Parameters
@@ -105,18 +145,14 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
     curves : list of (m_i, 3) float64
         Network curves (polylines); curves meeting at a junction share end points.
     loops : list of list of (int, bool)
-        Patches: each a closed loop of (curve index, traversed forward). Loops that
-        traverse shared curves in opposite directions give a consistently oriented
-        mesh; inconsistent loops are flipped to agree (first loop wins).
-    crease_curves : iterable of int
-        Curves labelled crease.
-    crease_angle : float or None
-        Degrees; shared curves whose patches meet at a larger dihedral angle become
-        creases too. None: labelled creases only.
+        Patches: each a closed loop of (curve index, traversed forward); loops that
+        disagree in orientation are flipped to agree with the first one.
+    crease_curves, crease_angle : iterable of int, float or None
+        Curves labelled crease; shared curves whose patches meet at a dihedral angle
+        above ``crease_angle`` degrees become creases too (None: labelled ones only).
     resolution : int
-        Control-polygon segments per curve piece (>= 2; odd values are rounded up to
-        even). Long or winding curves get several pieces (see
-        :func:`surfacing.controlmesh.curve_pieces`).
+        Control-polygon segments per curve piece (>= 2, odd rounded up to even); long
+        or winding curves get several pieces (:func:`surfacing.controlmesh.curve_pieces`).
     subdiv : int
         Catmull-Clark levels for the output mesh (>= 0).
     fit : {"lsq", "iterative"}
@@ -128,29 +164,25 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
     straight_angle : float
         Degrees; curves turning less at a junction form one patch side, and two sharp
         curves turning more make a corner.
-    tol : float
-        Iterative fit: stop tolerance on curve deviation, fraction of the diagonal.
-    max_iter : int
-        Iterative fit: iteration cap.
-    lam : float
-        Iterative fit: damping of Eq. 3.
+    tol, max_iter, lam, vspring_step : float, int, float, float
+        Iterative fit: stop tolerance on curve deviation (fraction of the diagonal),
+        iteration cap, damping of Eq. 3, and the fraction of the V-spring displacement
+        applied per iteration (1.0 as published; see :data:`surfacing.fit.VSPRING_STEP`).
     curve_weight : float or None
         lsq fit: None interpolates exactly; a positive weight trades interpolation
         for fairness (use with ``update_curves``).
-    vspring_step : float
-        Iterative fit: fraction of the V-spring displacement applied per iteration
-        (1.0 as published; 0.5 by default, see :data:`surfacing.fit.VSPRING_STEP`).
     fairness : {"variation", "thin-plate"}
         lsq fit energy: differences of the control net's umbrella Laplacian across
         edges (linear curvature variation, default) or the Laplacian itself.
 
     Returns
     -------
-    SurfaceResult
+    PatchMeshResult
+        The last subdivision level pushed to the limit; ``report`` deviations are fractions
+        of the diagonal. Bad options raise ``InvalidParameterError`` before any work.
 
     Examples
     --------
-    >>> import numpy as np
     >>> t = np.linspace(0, 1, 9)[:, None]
     >>> sq = [t * [1, 0, 0], [1, 0, 0] + t * [0, 1, 0], [1, 1, 0] - t * [1, 0, 0],
     ...       [0, 1, 0] - t * [0, 1, 0]]
@@ -158,37 +190,57 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
     >>> bool(np.abs(res.vertices[:, 2]).max() < 1e-12)
     True
 
-    Notes
-    -----
-    Output vertex order: the vertices of the last subdivision level, pushed to their
-    limit positions with :func:`surfacing.limit.limit_matrix`. ``report`` deviations
-    are fractions of the curves' bounding-box diagonal.
-
     References
     ----------
-    Orbay & Kara 2011, Sec. 4.2 (Coons patches), 4.3.1 (limit masks, Eq. 1-2),
-    4.3.2 (Eq. 3-4), 4.3.3 (curve update); Halstead, Kass & DeRose 1993.
+    Orbay & Kara 2011, Sec. 4.2, 4.3.1 (Eq. 1-2), 4.3.2 (Eq. 3-4), 4.3.3; Halstead et al. 1993.
     """
-    if fit not in ("lsq", "iterative"):
-        raise ValueError(f"fit: expected 'lsq' or 'iterative', got {fit!r}")
-    if int(subdiv) != subdiv or subdiv < 0:
-        raise ValueError(f"subdiv: expected an integer >= 0, got {subdiv!r}")
-    _check_output_size(len(loops), resolution, int(subdiv))
-    if fairness not in FAIRNESS:
-        raise ValueError(f"fairness: expected one of {FAIRNESS}, got {fairness!r}")
-    if not tol > 0:
-        raise ValueError(f"tol: expected > 0, got {tol!r}")
-    subdiv = int(subdiv)
-    timings = {}
+    check_loops_options(resolution=resolution, subdiv=subdiv, fit=fit, tol=tol, lam=lam,
+                        straight_angle=straight_angle, curve_weight=curve_weight,
+                        fairness=fairness, n_loops=len(loops))
+    update = _curve_selection(update_curves, len(curves))
+    cm, curves, (crease, detected, *sharp, _), timings = _build(
+        curves, loops, resolution, crease_curves, crease_angle, straight_angle)
+    P, iters, sample_dev = _fit_control_net(
+        cm, sharp, fit=fit, fairness=fairness, curve_weight=curve_weight, lam=lam, tol=tol,
+        max_iter=max_iter, vspring_step=vspring_step, timings=timings)
+    V, faces, face_patch, chains = _limit_surface(P, cm, sharp, int(subdiv), timings)
+    dev, new_curves = _curve_fit_report(V, chains, curves, cm, update, timings)
+    report = _report(cm, fit=fit, dev=dev, sample_dev=sample_dev, iters=iters, timings=timings,
+                     crease=crease, detected=detected, n_faces=len(faces),
+                     resolution=resolution, subdiv=int(subdiv))
+    return PatchMeshResult(V, faces, report, face_patch=face_patch, curves=new_curves,
+                           control_vertices=P, control_quads=cm.quads)
+
+
+def _build(curves, loops, resolution, crease_curves, crease_angle, straight_angle):
+    """Control mesh (Coons patches, Sec. 4.2), float64 curves, sharp structure, timings."""
     t0 = time.perf_counter()
     cm = build_control_mesh(curves, loops, resolution, straight_angle=straight_angle)
     curves = [np.asarray(c, dtype=np.float64) for c in curves]
-    diag = cm.diagonal if cm.diagonal > 0 else 1.0
-    crease, detected, sharp_edges, corners, dih = sharp_structure(
-        cm, curves, crease_curves, crease_angle=crease_angle, straight_angle=straight_angle)
-    timings["build"] = time.perf_counter() - t0
+    sharp = sharp_structure(cm, curves, crease_curves, crease_angle=crease_angle,
+                            straight_angle=straight_angle)
+    return cm, curves, sharp, {"build": time.perf_counter() - t0}
 
+
+def _curve_selection(update_curves, n_curves: int):
+    """Indices of the curves to refit (``update_curves``), or None; checked up front."""
+    if update_curves is False or update_curves is None:
+        return None
+    sel = range(n_curves) if update_curves is True else [int(i) for i in update_curves]
+    for c in sel:
+        if not 0 <= c < n_curves:
+            raise InvalidParameterError(f"update_curves: index {c} out of range [0, {n_curves})")
+    return sel
+
+
+def _fit_control_net(cm, sharp, *, fit, fairness, curve_weight, lam, tol, max_iter,
+                     vspring_step, timings):
+    """Control points whose limit interpolates the curve samples (Sec. 4.3.2).
+
+    Returns ``(P (n, 3) float64, iterations, sample deviations (k,) float64)``.
+    """
     t0 = time.perf_counter()
+    sharp_edges, corners = sharp
     n = len(cm.vertices)
     L = limit_matrix(cm.quads, n, sharp_edges, corners)
     cons = np.flatnonzero(cm.on_curve)
@@ -200,6 +252,7 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
         P = fit_lsq(L, F, cm.vertices, cons, targets, curve_weight=curve_weight)
         iters = 1
     else:
+        diag = cm.diagonal if cm.diagonal > 0 else 1.0
         T1, T2, has = tangent_matrices(cm.quads, n, sharp_edges, corners)
         P, iters, _ = fit_iterative(L, T1, T2, has, cm.quads, cm.vertices, cons, targets,
                                     lam=lam, tol=tol * diag, max_iter=max_iter,
@@ -207,9 +260,17 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
                                     vspring_step=vspring_step)
     sample_dev = np.linalg.norm((L @ P)[cons] - targets, axis=1)
     timings["fit"] = time.perf_counter() - t0
+    return P, iters, sample_dev
 
+
+def _limit_surface(P, cm, sharp, subdiv: int, timings):
+    """Subdivide the control net ``subdiv`` times and push the vertices to the limit.
+
+    Returns ``(vertices (n, 3) float64, faces (f, 3) int64, face_patch (f,) int64,
+    chains)``, ``chains[c]`` the output vertex ids along curve ``c``.
+    """
     t0 = time.perf_counter()
-    V, Q, se, cr = P, cm.quads, sharp_edges, corners
+    V, Q, (se, cr) = P, cm.quads, sharp
     fpatch = cm.face_patch
     chains = list(cm.curve_vids)
     for _ in range(subdiv):
@@ -224,33 +285,40 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
         chains = new_chains
         V, Q, se, cr = st.S @ V, st.quads, st.sharp_edges, st.corners
         fpatch = fpatch[st.face_parent]
-    Lk = limit_matrix(Q, len(V), se, cr)
-    Vout = Lk @ V
+    Vout = limit_matrix(Q, len(V), se, cr) @ V
     faces = _quads_to_tris(Q)
-    face_patch = np.concatenate([fpatch, fpatch])
     timings["output"] = time.perf_counter() - t0
+    return Vout, faces, np.concatenate([fpatch, fpatch]), chains
 
+
+def _curve_fit_report(V, chains, curves, cm, update, timings):
+    """Distances of the limit points along the used curves to the input polylines, and the
+    curves refitted to the surface (Sec. 4.3.3) when ``update`` lists some (else None)."""
     t0 = time.perf_counter()
     used = np.zeros(len(curves), bool)
     for lp in cm.loops:
         for ci, _ in lp:
             used[ci] = True
-    dev = [point_polyline_distance(Vout[chains[c]], curves[c]) for c in np.flatnonzero(used)]
+    dev = [point_polyline_distance(V[chains[c]], curves[c]) for c in np.flatnonzero(used)]
     dev = np.concatenate(dev) if dev else np.zeros(1)
     new_curves = None
-    if update_curves is not False and update_curves is not None:
-        sel = range(len(curves)) if update_curves is True else [int(i) for i in update_curves]
+    if update is not None:
         new_curves = list(curves)
-        for c in sel:
-            if not 0 <= c < len(curves):
-                raise ValueError(f"update_curves: index {c} out of range [0, {len(curves)})")
+        for c in update:
             if used[c]:
-                new_curves[c] = fit_cubic_curve(Vout[chains[c]], len(curves[c]))
+                new_curves[c] = fit_cubic_curve(V[chains[c]], len(curves[c]))
     timings["report"] = time.perf_counter() - t0
+    return dev, new_curves
+
+
+def _report(cm, *, fit, dev, sample_dev, iters, timings, crease, detected, n_faces,
+            resolution, subdiv) -> dict:
+    """The report of :func:`surface_loops`; deviations become fractions of the diagonal."""
+    diag = cm.diagonal if cm.diagonal > 0 else 1.0
     kinds: dict = {}
     for k in cm.patch_kind:
         kinds[k] = kinds.get(k, 0) + 1
-    report = {
+    return {
         "fit": fit,
         "max_curve_deviation": float(dev.max() / diag),
         "mean_curve_deviation": float(dev.mean() / diag),
@@ -260,16 +328,15 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
         "creases": [int(i) for i in np.flatnonzero(crease)],
         "creases_detected": detected,
         "n_patches": len(cm.loops),
-        "n_control_vertices": int(n),
-        "n_faces": int(len(faces)),
+        "n_control_vertices": int(len(cm.vertices)),
+        "n_faces": int(n_faces),
         "patch_kinds": kinds,
         "resolution": int(resolution) + int(resolution) % 2,
         "subdiv": subdiv,
     }
-    return SurfaceResult(Vout, faces, face_patch, report, new_curves, P, cm.quads)
 
 
-def soapfilm_loops(curves, loops, *, resolution: int = 16, **_ignored) -> SurfaceResult:
+def soapfilm_loops(curves, loops, *, resolution: int = 16, **_ignored) -> PatchMeshResult:
     """Soap-film baseline (Abbasinejad et al. 2011, Sec. 7) with the classical API.
 
     Parameters
@@ -284,12 +351,13 @@ def soapfilm_loops(curves, loops, *, resolution: int = 16, **_ignored) -> Surfac
 
     Returns
     -------
-    SurfaceResult
+    PatchMeshResult
         ``report`` has ``n_patches``, ``timings`` and ``max_curve_deviation`` (0 by
         construction: the boundary samples are vertices).
     """
     t0 = time.perf_counter()
     V, F, fp = soapfilm_mesh(curves, loops, resolution=resolution)
-    return SurfaceResult(V, F, fp, {"fit": "soapfilm", "n_patches": len(loops),
-                                    "max_curve_deviation": 0.0,
-                                    "timings": {"total": time.perf_counter() - t0}})
+    return PatchMeshResult(V, F, {"fit": "soapfilm", "n_patches": len(loops),
+                                  "max_curve_deviation": 0.0,
+                                  "timings": {"total": time.perf_counter() - t0}},
+                           face_patch=fp)

@@ -1,0 +1,56 @@
+"""The one result type every surfacer returns: a triangle mesh and a report.
+
+Backends (``curvenet.surfacing``, ``curvenet.neural``) return :class:`MeshResult`
+or a thin subclass that adds what only that backend has (per-face patch ids, a
+control mesh, an implicit field); the graph code reads only the three fields
+below, so any surfacer can stand in for any other.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+__all__ = ["MeshResult"]
+
+
+@dataclass(repr=False)
+class MeshResult:
+    """A triangle mesh and what its backend reports about it.
+
+    Attributes
+    ----------
+    vertices : (n, 3) float64
+        Vertex positions in the input's coordinates.
+    faces : (f, 3) int64
+        Triangles, indices into ``vertices``, consistently oriented.
+    report : dict
+        Backend diagnostics (timings, deviations, settings); JSON-serialisable values.
+
+    Examples
+    --------
+    >>> res = MeshResult([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]])
+    >>> res
+    <MeshResult(vertices.shape=(3, 3), faces.shape=(1, 3))>
+    >>> res.vertices.dtype, res.faces.dtype
+    (dtype('float64'), dtype('int64'))
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    report: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        # no copy when the arrays already have the documented dtypes
+        self.vertices = np.asarray(self.vertices, dtype=np.float64).reshape(-1, 3)
+        self.faces = np.asarray(self.faces, dtype=np.int64).reshape(-1, 3)
+
+    def to_trimesh(self):
+        """The mesh as a ``trimesh.Trimesh`` (not processed: vertices and faces as they are)."""
+        import trimesh
+        return trimesh.Trimesh(self.vertices, self.faces, process=False)
+
+    def __repr__(self) -> str:
+        return (f"<{type(self).__name__}(vertices.shape={self.vertices.shape}, "
+                f"faces.shape={self.faces.shape})>")
