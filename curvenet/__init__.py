@@ -31,6 +31,12 @@ _LAZY = {
     "SurfaceResult": "pipeline",
     "evaluate_mesh": "evaluate",
     "render_preview": "preview",
+    "MeshResult": "core.result",
+    "register_surfacer": "surfacers",
+    "unregister_surfacer": "surfacers",
+    "surfacer_names": "surfacers",
+    "SurfaceInput": "surfacers",
+    "RouteDecision": "route",
 }
 
 __all__ = [
@@ -47,3 +53,8 @@ def __getattr__(name):
         globals()[name] = value
         return value
     raise AttributeError(f"module 'curvenet' has no attribute {name!r}")
+
+
+def __dir__():
+    """What ``dir(curvenet)`` and tab completion show: the lazy names too."""
+    return sorted(set(globals()) | set(__all__))

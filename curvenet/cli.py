@@ -76,6 +76,8 @@ def _points(args):
 
 
 def build_parser() -> argparse.ArgumentParser:
+    from .pipeline import METHODS
+    from .surfacers import get_surfacer, surfacer_names
     p = _Parser(prog="curvenet", description="3D sketches and curve networks to surfaces.")
     p.add_argument("--debug", action="store_true", help="show tracebacks on errors")
     sub = p.add_subparsers(dest="command", required=True)
@@ -116,12 +118,16 @@ def build_parser() -> argparse.ArgumentParser:
                         "stroke fidelity, output, status)")
     s.add_argument("--preview-dir", metavar="DIR",
                    help="batch: a picture per file and contact_sheet.png of the batch")
-    s.add_argument("--method", choices=("auto", "classical", "neural"), default="auto")
+    s.add_argument("--method", choices=METHODS + surfacer_names(), default="auto",
+                   help="auto: classical when the patches cover the curves, else neural; "
+                        "classical: the --surfacer on the patches; or a surfacer: "
+                        + "; ".join(f"{n}: {get_surfacer(n).summary}" for n in surfacer_names()))
     s.add_argument("--patches", metavar="PATCHES.json", help="use this (edited) patch set")
     s.add_argument("--snap-tol", type=_fraction)
     s.add_argument("--close", choices=("auto", "none"), default="auto")
     s.add_argument("--points", action="store_true", help=_POINTS_HELP)
-    s.add_argument("--surfacer", choices=("catmull-clark", "soapfilm"), default="catmull-clark")
+    s.add_argument("--surfacer", choices=surfacer_names("patches"), default="catmull-clark",
+                   help="surfacer of the classical route (default catmull-clark)")
     s.add_argument("--subdiv", type=_positive_int, help="Catmull-Clark levels")
     s.add_argument("--resolution", type=_positive_int, help="Coons samples per side segment")
     s.add_argument("--crease-angle", type=float, default=30.0, metavar="DEG")
@@ -231,7 +237,7 @@ def _surface_one(inp: str, out: str, args) -> dict:
                            title=f"{Path(inp).name}: {res.method}", up=args.up)
         return {"input": inp, "output": out, "status": "ok", "method": res.method,
                 "faces": len(res.mesh.faces), "seconds": time.perf_counter() - t0,
-                "why": res.diagnostics.get("decision", ""), "interrupted": res.interrupted,
+                "why": res.decision.explain(), "interrupted": res.interrupted,
                 "reading": res.diagnostics.get("reading", "")}
     except CurvenetError as err:
         return {"input": inp, "output": out, "status": "error", "error": _naming(err, inp),

@@ -3,7 +3,9 @@
 ``surface(...)`` decides by itself (``method="auto"``) whether the classical
 patch route (Coons -> Catmull-Clark limit fit, :mod:`surfacing`) or the neural
 route (flow-aligned implicit, :mod:`neural`) serves the sketch better, and says
-why in ``SurfaceResult.diagnostics["decision"]``.
+why in ``SurfaceResult.decision`` (a :class:`~curvenet.route.RouteDecision`; its
+sentence is ``SurfaceResult.diagnostics["decision"]``). The surfacers themselves
+come from the registry of :mod:`curvenet.surfacers`.
 """
 
 from __future__ import annotations
@@ -15,21 +17,24 @@ from pathlib import Path
 import numpy as np
 
 from ._atomic import atomic_path
+from .core.result import MeshResult
 from .errors import CurvenetError, InvalidParameterError, SketchFormatError
 from .network import CurveNetwork
 from .patchset import PatchSet, load_network_file
+from .route import AUTO_MIN_COVERAGE, RouteDecision, auto_route, coverage
 from .sketch import Sketch
+from .surfacers import (SurfaceInput, SurfaceSettings, Surfacer, get_surfacer,
+                        surfacer_names)
 
 __all__ = ["SurfaceResult", "surface", "patches", "load_source", "MESH_FORMATS",
            "AUTO_MIN_COVERAGE", "write_mesh"]
 
 MESH_FORMATS = (".obj", ".ply", ".stl", ".off", ".glb")
-METHODS = ("auto", "classical", "neural")
+#: methods that name a route; every registered surfacer name is a method too
+METHODS = ("auto", "classical")
 QUALITIES = ("draft", "default", "paper")
-
-#: auto mode takes the classical route when at least this fraction of the
-#: network's curve length lies on curves used by some patch.
-AUTO_MIN_COVERAGE = 0.8
+#: the surfacer of the neural route (auto's fallback, and ``refine``)
+STROKE_SURFACER = "neural"
 
 
 @dataclass
@@ -41,16 +46,20 @@ class SurfaceResult:
     mesh : trimesh.Trimesh
         The surface, in the sketch's coordinates.
     method : str
-        ``"classical"``, ``"soapfilm"`` or ``"neural"``; with ``refine``, the
-        classical name plus ``"+refine"`` (e.g. ``"classical+refine"``).
+        The label of the surfacer that ran (``"classical"``, ``"soapfilm"``,
+        ``"neural"`` ...), with ``"+refine"`` when the neural refinement followed.
     sketch : Sketch or None
     network : CurveNetwork or None
     patchset : PatchSet or None
     timings : dict
-        Seconds per stage (``snap``, ``patches``, ``classical``, ``neural`` ...).
+        Seconds per stage (``snap``, ``patches``, then one per surfacer label:
+        ``classical``, ``neural`` ...).
     diagnostics : dict
-        ``decision`` (why this route), ``coverage``, ``unused_edges`` (curves no
-        patch uses: dangling details, reported not lost), backend reports.
+        ``decision`` (why this route, one sentence), ``coverage``, ``unused_edges``
+        (curves no patch uses: dangling details, reported not lost), and each
+        surfacer's report under its label.
+    decision : RouteDecision or None
+        The route decision as data (``dataclasses.asdict`` makes it JSON).
     """
 
     mesh: object
@@ -60,6 +69,7 @@ class SurfaceResult:
     patchset: PatchSet | None = None
     timings: dict = field(default_factory=dict)
     diagnostics: dict = field(default_factory=dict)
+    decision: RouteDecision | None = None
 
     @property
     def interrupted(self) -> bool:
@@ -71,6 +81,10 @@ class SurfaceResult:
     def save(self, path) -> Path:
         """Write the mesh atomically; the format follows the extension."""
         return write_mesh(path, self.mesh)
+
+    def __repr__(self) -> str:
+        return (f"<SurfaceResult(method={self.method!r}, "
+                f"vertices={len(self.mesh.vertices)}, faces={len(self.mesh.faces)})>")
 
 
 def write_mesh(path, mesh) -> Path:
@@ -189,7 +203,7 @@ def _check_patches_match(sketch: Sketch, ps: PatchSet) -> None:
     net = ps.network
     strokes = np.concatenate(sketch.select(("boundary", "crease")).strokes or sketch.strokes)
     curves = (np.concatenate([e.curve for e in net.edges]) if net.edges
-              else np.asarray(net.vertices, np.float64).reshape(-1, 3))
+              else np.asarray(net.positions, np.float64).reshape(-1, 3))
     diag = float(np.linalg.norm(strokes.max(axis=0) - strokes.min(axis=0)))
     if len(curves) == 0 or not diag > 0:
         return
@@ -202,67 +216,133 @@ def _check_patches_match(sketch: Sketch, ps: PatchSet) -> None:
             "from the other (were the patches made from another sketch?)")
 
 
-def _coverage(ps: PatchSet) -> tuple[float, list]:
-    """Fraction of curve length on edges used by a patch, and the unused edge ids."""
-    net = ps.network
-    if not net.edges:
-        return 0.0, []
-    lengths = np.array([e.length() for e in net.edges])
-    used = np.zeros(len(lengths), bool)
-    for p in ps.patches:
-        used[list(p.edges)] = True
-    total = lengths.sum()
-    cov = float(lengths[used].sum() / total) if total > 0 else 0.0
-    return cov, [int(i) for i in np.flatnonzero(~used)]
+def _load(source, patchset: PatchSet | None, points, diag: dict):
+    """``(sketch, patch set)`` of the input; a given ``patchset`` must match the sketch."""
+    sketch, given = load_source(source, points=points)
+    if sketch is not None:
+        diag["reading"] = sketch.metadata.get("reading", "polylines: no stroke is a block of "
+                                              "unordered points" if points is not False else
+                                              "polylines: point reading off")
+    if patchset is not None:
+        given = patchset
+        if sketch is not None:
+            _check_patches_match(sketch, patchset)
+    if sketch is not None and len(sketch.select(("boundary", "crease"))) == 0:
+        raise InvalidParameterError(f"{sketch.source or 'sketch'}: no boundary or crease strokes")
+    return sketch, given
 
 
-def _mesh(vertices, faces):
-    import trimesh
-    return trimesh.Trimesh(np.asarray(vertices, np.float64), np.asarray(faces, np.int64),
-                           process=False)
+def _check_settings(method: str, s: SurfaceSettings) -> None:
+    """The pipeline's own settings (each surfacer checks its options)."""
+    methods = METHODS + surfacer_names()
+    if method not in methods:
+        raise InvalidParameterError(f"method: {method!r} is not one of {methods}")
+    if s.quality not in QUALITIES:
+        raise InvalidParameterError(f"quality: {s.quality!r} is not one of {QUALITIES}")
+    if not (0.0 < s.crease_angle < 180.0):
+        raise InvalidParameterError(f"crease_angle: {s.crease_angle!r} is not in (0, 180)")
+    if s.device not in ("cpu", "cuda") and not str(s.device).startswith("cuda:"):
+        raise InvalidParameterError(f"device: {s.device!r} is not cpu or cuda")
 
 
-def _classical(ps: PatchSet, *, surfacer, subdiv, resolution, crease_angle, options):
-    from curvenet import surfacing
+@dataclass
+class _Plan:
+    """The surfacers a call may run and their checked options (name -> dict)."""
 
-    from .cycles import orient_patches
-    net = ps.network
-    loops = orient_patches(net, ps.patches)
-    curves = [e.curve for e in net.edges]
-    creases = [i for i, e in enumerate(net.edges) if e.label == "crease"]
-    kw = dict(options)
-    if surfacer == "soapfilm":
-        res = surfacing.soapfilm_loops(curves, loops, **kw)
+    patch: Surfacer | None      # the classical route
+    stroke: Surfacer | None     # the neural route, or the refinement after the classical one
+    options: dict
+    refine: bool                # run ``stroke`` on the result of ``patch``
+
+
+def _plan(method: str, surfacer: str, refine: bool, settings: SurfaceSettings, *,
+          classical_options, neural_options, crease_options) -> _Plan:
+    """Choose the candidate surfacers and validate their options, before any work."""
+    _check_settings(method, settings)
+    patch = get_surfacer(surfacer, "patches")
+    stroke = get_surfacer(STROKE_SURFACER, "strokes")
+    if method not in METHODS:
+        chosen = get_surfacer(method)
+        patch, stroke = (chosen, stroke) if chosen.needs == "patches" else (None, chosen)
+    refine = bool(refine) and patch is not None
+    checked = [s for s in (patch, stroke) if s]
+    if method != "auto" and patch is not None and not refine:
+        stroke = None
+    stroke_options = dict(neural_options or {})
+    if crease_options:
+        stroke_options["creases"] = crease_options
+    given = {"patches": classical_options, "strokes": stroke_options}
+    # options given are checked even for a surfacer this route will not run
+    options = {s.name: s.validate(given[s.needs], settings) for s in checked
+               if s in (patch, stroke) or given[s.needs]}
+    return _Plan(patch, stroke, options, refine)
+
+
+def _find_patches(sketch, given, *, snap_tol, close, timings, diag):
+    """Snap (unless given a network) and find patches (unless given some)."""
+    from .cycles import find_patches
+    net = _network(sketch, given, snap_tol=snap_tol, timings=timings)
+    diag["snap"] = dict(net.report)
+    if given is not None and given.patches:
+        ps = given
     else:
-        if subdiv is not None:
-            kw["subdiv"] = subdiv
-        if resolution is not None:
-            kw["resolution"] = resolution
-        res = surfacing.surface_loops(curves, loops, crease_curves=creases,
-                                      crease_angle=crease_angle, **kw)
-    return _mesh(res.vertices, res.faces), dict(res.report)
+        t = time.perf_counter()
+        ps = find_patches(net, close=close)
+        timings["patches"] = time.perf_counter() - t
+    cov, unused = coverage(ps)
+    diag.update(coverage=cov, unused_edges=unused, patches=len(ps.patches))
+    return net, ps
 
 
-def _strokes_for_neural(sketch: Sketch | None, net: CurveNetwork | None):
+def _decide(method: str, plan: _Plan, diag: dict) -> RouteDecision:
+    """The route: auto's rule, or what was requested (with the coverage when sought)."""
+    if method == "auto":
+        return auto_route(diag["patches"], diag["coverage"], patch_surfacer=plan.patch.name,
+                          stroke_surfacer=plan.stroke.name)
+    first = plan.patch or plan.stroke
+    sought = {k: diag[k] for k in ("coverage", "patches") if k in diag}
+    return RouteDecision(method, first.name, "requested", **sought)
+
+
+def _classical(plan: _Plan, decision: RouteDecision) -> bool:
+    """Whether the decision takes the route that needs patches."""
+    return plan.patch is not None and decision.surfacer == plan.patch.name
+
+
+def _strokes(sketch: Sketch | None, net: CurveNetwork | None):
     if sketch is not None:
         sub = sketch.select(("boundary", "crease"))
         return sub.strokes, sub.labels
     return [e.curve for e in net.edges], [e.label for e in net.edges]
 
 
-def _neural(strokes, labels, *, quality, device, seed, progress, init_mesh, options,
-            crease_options):
-    from curvenet.neural.flow import fit_flow_surface
-    res = fit_flow_surface(strokes, labels=labels, quality=quality, device=device, seed=seed,
-                           init_mesh=init_mesh, progress=progress, **options)
-    verts, faces, report = res.vertices, res.faces, dict(res.report)
-    if "crease" in labels and not report.get("interrupted"):
-        from curvenet.neural.creases import crease_refine
-        cres = crease_refine(verts, faces, strokes, labels, quality=quality, device=device,
-                             seed=seed, progress=progress, **crease_options)
-        verts, faces = cres.vertices, cres.faces
-        report["creases"] = dict(cres.report)
-    return _mesh(verts, faces), report
+def _run(surfacer: Surfacer, inp: SurfaceInput, options: dict, timings, diag) -> MeshResult:
+    """Run one surfacer; its seconds and report are filed under its label."""
+    t = time.perf_counter()
+    res = surfacer(inp, options)
+    timings[surfacer.label] = time.perf_counter() - t
+    diag[surfacer.label] = dict(res.report)
+    return res
+
+
+def _surface_route(plan: _Plan, decision: RouteDecision, settings: SurfaceSettings, *,
+                   sketch, net, ps, timings, diag):
+    """Run the decided surfacer (and the refinement); returns ``(MeshResult, name)``."""
+    res, name, init = None, None, None
+    if _classical(plan, decision):
+        from .cycles import orient_patches
+        edges = net.edges
+        inp = SurfaceInput(settings, curves=[e.curve for e in edges],
+                           loops=orient_patches(net, ps.patches),
+                           crease_curves=[i for i, e in enumerate(edges) if e.label == "crease"])
+        res = _run(plan.patch, inp, plan.options[plan.patch.name], timings, diag)
+        name, init = plan.patch.label, (res.vertices, res.faces)
+    if res is None or plan.refine:
+        strokes, labels = _strokes(sketch, net)
+        inp = SurfaceInput(settings, strokes=strokes, labels=labels, init_mesh=init)
+        res = _run(plan.stroke, inp, plan.options[plan.stroke.name], timings, diag)
+        name = plan.stroke.label if init is None else name + "+refine"
+    return res, name
 
 
 def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
@@ -278,44 +358,41 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
     Parameters
     ----------
     source : Sketch, CurveNetwork, PatchSet, str or os.PathLike
-        The input: a sketch, a sketch file in any supported format, or a
-        ``NETWORK.json`` / ``PATCHES.json`` file.
-    method : {"auto", "classical", "neural"}
-        ``auto`` snaps, finds patches and takes the classical route when the
-        patches cover at least :data:`AUTO_MIN_COVERAGE` of the curve length,
-        else the neural route.
+        A sketch, a sketch file in any supported format, or a ``NETWORK.json`` /
+        ``PATCHES.json`` file.
+    method : str
+        ``"auto"`` snaps, finds patches and takes the classical route when they cover at
+        least :data:`AUTO_MIN_COVERAGE` of the curve length, else the neural route;
+        ``"classical"`` (the ``surfacer``), or any name of :func:`surfacers.surfacer_names`.
     patchset : PatchSet, optional
         Use these patches (e.g. an edited ``PATCHES.json``) instead of finding them.
     snap_tol : float, optional
         Snapping tolerance (fraction of the bounding-box diagonal).
     close : {"auto", "none"}
         Closing-patch policy of the patch finder.
-    surfacer : {"catmull-clark", "soapfilm"}
-        Classical surfacer: Orbay-Kara limit fitting or the soap-film baseline.
+    surfacer : str
+        Surfacer of the classical route: ``"catmull-clark"`` (Orbay-Kara limit fitting),
+        ``"soapfilm"`` (the baseline) or another that needs patches.
     subdiv, resolution : int, optional
-        Classical settings (Catmull-Clark levels, samples per side); backend defaults.
+        Subdivision levels, samples per curve of the classical surfacer; its defaults.
     crease_angle : float
         Dihedral angle (degrees) above which a curve becomes a crease.
     refine : bool
         Continue the classical result with the neural flow-alignment fit.
-    quality : {"draft", "default", "paper"}
-        Neural preset.
-    device : str
-        ``"cpu"`` or ``"cuda"`` for the neural route.
-    seed : int
-        Seed of every random choice.
-    progress : bool
-        Show progress bars.
+    quality, device, seed, progress
+        Neural preset (``"draft"``, ``"default"``, ``"paper"``), ``"cpu"`` or ``"cuda"``,
+        the seed of every random choice, progress bars.
     classical_options, neural_options : dict, optional
-        Extra keyword arguments for :func:`surfacing.surface_loops` /
-        :func:`neural.flow.fit_flow_surface`.
+        Options of the classical surfacer (:func:`surfacing.surface_loops` keywords) and
+        of the neural one (:class:`neural.presets.FlowConfig` fields).
     crease_options : dict, optional
-        Settings of the crease refit (:class:`neural.creases.CreaseConfig`, e.g.
-        ``{"use_features": False}``), used when the neural route meets strokes labelled
-        ``crease``; checked before any fit.
+        Settings of the neural crease refit (:class:`neural.creases.CreaseConfig`).
     points : {"auto", True, False}
-        Reading of unordered point samples (see :func:`load_source`); the
-        reading taken is in ``diagnostics["reading"]``.
+        Reading of unordered point samples (see :func:`load_source`); the reading taken
+        is in ``diagnostics["reading"]``.
+
+    Every option is checked before any work (``InvalidParameterError`` names it); a
+    failure inside a surfacer is an internal error and propagates as it is.
 
     Returns
     -------
@@ -325,100 +402,24 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
     --------
     >>> from curvenet import shapes
     >>> res = surface(shapes.box().sketch(), method="classical")
-    >>> res.method, res.mesh.is_watertight
-    ('classical', True)
+    >>> res.method, res.mesh.is_watertight, res.decision.explain()
+    ('classical', True, 'classical: requested')
     """
-    if method not in METHODS:
-        raise InvalidParameterError(f"method: {method!r} is not one of {METHODS}")
-    if quality not in QUALITIES:
-        raise InvalidParameterError(f"quality: {quality!r} is not one of {QUALITIES}")
-    if surfacer not in ("catmull-clark", "soapfilm"):
-        raise InvalidParameterError(f"surfacer: {surfacer!r} is not catmull-clark or soapfilm")
-    if not (0.0 < crease_angle < 180.0):
-        raise InvalidParameterError(f"crease_angle: {crease_angle!r} is not in (0, 180)")
-    if device not in ("cpu", "cuda") and not str(device).startswith("cuda:"):
-        raise InvalidParameterError(f"device: {device!r} is not cpu or cuda")
-    if neural_options:
-        from curvenet.neural.presets import get_config
-        try:
-            get_config(quality, **neural_options)
-        except ValueError as err:
-            raise InvalidParameterError(f"neural_options: {err}") from err
-    if crease_options:
-        from curvenet.neural.creases import crease_config
-        try:
-            crease_config(quality, crease_options)
-        except ValueError as err:
-            raise InvalidParameterError(f"crease_options: {err}") from err
-    timings: dict = {}
-    diag: dict = {}
-    sketch, given = load_source(source, points=points)
-    if sketch is not None:
-        diag["reading"] = sketch.metadata.get("reading", "polylines: no stroke is a block of "
-                                              "unordered points" if points is not False else
-                                              "polylines: point reading off")
-    if patchset is not None:
-        given = patchset
-        if sketch is not None:
-            _check_patches_match(sketch, patchset)
-    if sketch is not None and len(sketch.select(("boundary", "crease"))) == 0:
-        raise InvalidParameterError(f"{sketch.source or 'sketch'}: no boundary or crease strokes")
-
-    ps = None
-    net = given.network if given is not None else None
-    if method in ("auto", "classical"):
-        from .cycles import find_patches
-        net = _network(sketch, given, snap_tol=snap_tol, timings=timings)
-        diag["snap"] = dict(net.report)
-        if given is not None and given.patches:
-            ps = given
-        else:
-            t = time.perf_counter()
-            ps = find_patches(net, close=close)
-            timings["patches"] = time.perf_counter() - t
-        cov, unused = _coverage(ps)
-        diag.update(coverage=cov, unused_edges=unused, patches=len(ps.patches))
-        if method == "auto":
-            if not ps.patches:
-                reason = "neural: the strokes form no cycles that can be patches"
-            elif cov < AUTO_MIN_COVERAGE:
-                reason = (f"neural: patches cover only {cov:.0%} of the curve length "
-                          f"(< {AUTO_MIN_COVERAGE:.0%})")
-            else:
-                reason = (f"classical: {len(ps.patches)} patches cover {cov:.0%} of the curve "
-                          f"length (>= {AUTO_MIN_COVERAGE:.0%})")
-            diag["decision"] = reason
-            method = reason.split(":")[0]
-        else:
-            diag["decision"] = "classical: requested"
-        if method == "classical" and not ps.patches:
-            raise CurvenetError("no patches found: the curves form no cycles; "
-                                "try --method neural")
-    else:
-        diag["decision"] = "neural: requested"
-
-    mesh = None
-    name = method
-    try:
-        if method == "classical":
-            t = time.perf_counter()
-            mesh, rep = _classical(ps, surfacer=surfacer, subdiv=subdiv, resolution=resolution,
-                                   crease_angle=crease_angle, options=classical_options or {})
-            timings["classical"] = time.perf_counter() - t
-            diag["classical"] = rep
-            name = "soapfilm" if surfacer == "soapfilm" else "classical"
-        if method == "neural" or refine:
-            strokes, labels = _strokes_for_neural(sketch, net)
-            init = (np.asarray(mesh.vertices), np.asarray(mesh.faces)) if mesh is not None else None
-            t = time.perf_counter()
-            mesh, rep = _neural(strokes, labels, quality=quality, device=device, seed=seed,
-                                progress=progress, init_mesh=init, options=neural_options or {},
-                                crease_options=crease_options or {})
-            timings["neural"] = time.perf_counter() - t
-            diag["neural"] = rep
-            name = name + "+refine" if init is not None else "neural"
-    except ValueError as err:
-        raise InvalidParameterError(str(err)) from err
-    if mesh is None or len(mesh.faces) == 0:
+    settings = SurfaceSettings(crease_angle, subdiv, resolution, quality, device, seed, progress)
+    plan = _plan(method, surfacer, refine, settings, classical_options=classical_options,
+                 neural_options=neural_options, crease_options=crease_options)
+    timings, diag = {}, {}
+    sketch, given = _load(source, patchset, points, diag)
+    net, ps = (given.network if given is not None else None), None
+    if plan.patch is not None:
+        net, ps = _find_patches(sketch, given, snap_tol=snap_tol, close=close, timings=timings,
+                                diag=diag)
+    decision = _decide(method, plan, diag)
+    diag["decision"] = decision.explain()
+    if _classical(plan, decision) and not ps.patches:
+        raise CurvenetError("no patches found: the curves form no cycles; try --method neural")
+    res, name = _surface_route(plan, decision, settings, sketch=sketch, net=net, ps=ps,
+                               timings=timings, diag=diag)
+    if len(res.faces) == 0:
         raise CurvenetError(f"the {name} route produced an empty surface")
-    return SurfaceResult(mesh, name, sketch, net, ps, timings, diag)
+    return SurfaceResult(res.to_trimesh(), name, sketch, net, ps, timings, diag, decision)

@@ -1,0 +1,103 @@
+"""Which surfacer serves a sketch, and why: the route decision as data.
+
+:func:`curvenet.surface` fills a :class:`RouteDecision`; :meth:`RouteDecision.explain`
+turns it into the sentence ``curvenet surface --explain`` prints. ``regions`` is kept
+for decisions made per region of the network (one entry per region).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+
+import numpy as np
+
+from .patchset import PatchSet
+
+__all__ = ["AUTO_MIN_COVERAGE", "RouteDecision", "REASONS", "coverage", "auto_route"]
+
+#: auto mode takes the classical route when at least this fraction of the
+#: network's curve length lies on curves used by some patch.
+AUTO_MIN_COVERAGE = 0.8
+
+#: reason code -> sentence (``str.format`` over the decision's fields)
+REASONS = {
+    "requested": "requested",
+    "no_cycles": "the strokes form no cycles that can be patches",
+    "low_coverage": "patches cover only {coverage:.0%} of the curve length "
+                    "(< {min_coverage:.0%})",
+    "covered": "{patches} patches cover {coverage:.0%} of the curve length "
+               "(>= {min_coverage:.0%})",
+}
+
+
+@dataclass
+class RouteDecision:
+    """The route :func:`curvenet.surface` took, as data (``dataclasses.asdict`` gives JSON).
+
+    Attributes
+    ----------
+    method : str
+        ``"classical"`` or ``"neural"`` (what ``auto`` chose), or the method requested.
+    surfacer : str
+        Registry name of the surfacer that ran (:mod:`curvenet.surfacers`).
+    reason : str
+        A key of :data:`REASONS`: ``"requested"``, ``"no_cycles"``, ``"low_coverage"``
+        or ``"covered"``.
+    coverage : float or None
+        Fraction of the curve length on curves some patch uses (None: no patches sought).
+    patches : int or None
+        Number of patches found (None: no patches sought).
+    min_coverage : float
+        The auto threshold the coverage was compared with.
+    regions : list
+        Per-region decisions, for routes that choose per region (empty otherwise).
+
+    Examples
+    --------
+    >>> RouteDecision("classical", "catmull-clark", "covered", 1.0, 6).explain()
+    'classical: 6 patches cover 100% of the curve length (>= 80%)'
+    """
+
+    method: str
+    surfacer: str
+    reason: str
+    coverage: float | None = None
+    patches: int | None = None
+    min_coverage: float = AUTO_MIN_COVERAGE
+    regions: list = field(default_factory=list)
+
+    def explain(self) -> str:
+        """``"<method>: <why>"``, the sentence ``--explain`` prints."""
+        return f"{self.method}: " + REASONS[self.reason].format(**asdict(self))
+
+
+def coverage(ps: PatchSet) -> tuple[float, list]:
+    """Fraction of curve length on edges used by a patch, and the unused edge ids."""
+    net = ps.network
+    if not net.edges:
+        return 0.0, []
+    lengths = np.array([e.length() for e in net.edges])
+    used = np.zeros(len(lengths), bool)
+    for p in ps.patches:
+        used[list(p.edges)] = True
+    total = lengths.sum()
+    cov = float(lengths[used].sum() / total) if total > 0 else 0.0
+    return cov, [int(i) for i in np.flatnonzero(~used)]
+
+
+def auto_route(n_patches: int, cov: float, *, patch_surfacer: str, stroke_surfacer: str,
+               min_coverage: float = AUTO_MIN_COVERAGE) -> RouteDecision:
+    """The auto rule: the classical route when patches cover at least ``min_coverage`` of
+    the curve length, else the neural route.
+
+    Examples
+    --------
+    >>> auto_route(0, 0.0, patch_surfacer="catmull-clark", stroke_surfacer="neural").explain()
+    'neural: the strokes form no cycles that can be patches'
+    """
+    common = dict(coverage=cov, patches=n_patches, min_coverage=min_coverage)
+    if not n_patches:
+        return RouteDecision("neural", stroke_surfacer, "no_cycles", **common)
+    if cov < min_coverage:
+        return RouteDecision("neural", stroke_surfacer, "low_coverage", **common)
+    return RouteDecision("classical", patch_surfacer, "covered", **common)
