@@ -15,6 +15,7 @@ import numpy as np
 from .core.geometry import arc_length, as_polyline
 from .core.strokes import LABELS
 from .errors import InvalidParameterError, NetworkError, SketchFormatError
+from .sketch import label_counts
 
 __all__ = ["Edge", "CurveNetwork", "indexed_network"]
 
@@ -46,6 +47,9 @@ class Edge:
         """Polyline length."""
         return arc_length(self.curve)
 
+    def __repr__(self) -> str:
+        return f"<Edge(u={self.u}, v={self.v}, points={len(self.curve)}, label={self.label!r})>"
+
 
 @dataclass
 class CurveNetwork:
@@ -75,6 +79,12 @@ class CurveNetwork:
 
     def __post_init__(self):
         self.positions = np.asarray(self.positions, dtype=np.float64).reshape(-1, 3)
+
+    def __repr__(self) -> str:
+        pts = self.positions
+        bounds = np.round([pts.min(0), pts.max(0)], 4).tolist() if len(pts) else None
+        return (f"<CurveNetwork(vertices={self.number_of_vertices}, edges={self.number_of_edges}, "
+                f"labels={label_counts(e.label for e in self.edges)}, bounds={bounds})>")
 
     # --- construction -----------------------------------------------------
     def add_vertex(self, point) -> int:

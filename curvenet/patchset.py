@@ -52,6 +52,12 @@ class PatchSet:
     patches: list = field(default_factory=list)
     report: dict = field(default_factory=dict)
 
+    def __repr__(self) -> str:
+        sources = [p.source for p in self.patches]
+        counts = {src: sources.count(src) for src in PATCH_SOURCES if src in sources}
+        return (f"<PatchSet(patches={len(self.patches)}, sources={counts}, "
+                f"network={self.network!r})>")
+
     def to_dict(self) -> dict:
         d = self.network.to_dict()
         d["format"] = "curvenet.patches"

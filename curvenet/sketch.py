@@ -14,7 +14,19 @@ import numpy as np
 
 from .core.strokes import LABELS, check_strokes
 
-__all__ = ["LABELS", "Sketch"]
+__all__ = ["LABELS", "Sketch", "label_counts"]
+
+
+def label_counts(labels) -> dict:
+    """``{label: count}`` in :data:`LABELS` order, labels that occur only.
+
+    Examples
+    --------
+    >>> label_counts(["crease", "boundary", "crease"])
+    {'boundary': 1, 'crease': 2}
+    """
+    labels = list(labels)
+    return {lab: labels.count(lab) for lab in LABELS if lab in labels}
 
 
 @dataclass
@@ -50,6 +62,11 @@ class Sketch:
 
     def __len__(self) -> int:
         return len(self.strokes)
+
+    def __repr__(self) -> str:
+        n = sum(len(s) for s in self.strokes)
+        return (f"<Sketch(strokes={len(self.strokes)}, points={n}, "
+                f"labels={label_counts(self.labels)}, bounds={np.round(self.bounds, 4).tolist()})>")
 
     @property
     def points(self) -> np.ndarray:
