@@ -43,8 +43,8 @@ class MeshResult:
 
     def __post_init__(self):
         # no copy when the arrays already have the documented dtypes
-        self.vertices = np.asarray(self.vertices, dtype=np.float64).reshape(-1, 3)
-        self.faces = np.asarray(self.faces, dtype=np.int64).reshape(-1, 3)
+        self.vertices = _rows3(self.vertices, np.float64, "vertices")
+        self.faces = _rows3(self.faces, np.int64, "faces")
 
     def to_trimesh(self):
         """The mesh as a ``trimesh.Trimesh`` (not processed: vertices and faces as they are)."""
@@ -54,3 +54,13 @@ class MeshResult:
     def __repr__(self) -> str:
         return (f"<{type(self).__name__}(vertices.shape={self.vertices.shape}, "
                 f"faces.shape={self.faces.shape})>")
+
+
+def _rows3(a, dtype, name: str) -> np.ndarray:
+    """``a`` as an ``(k, 3)`` array of ``dtype``; an empty input becomes ``(0, 3)``."""
+    a = np.asarray(a, dtype=dtype)
+    if a.size == 0:
+        return a.reshape(0, 3)
+    if a.ndim != 2 or a.shape[1] != 3:
+        raise ValueError(f"{name}: expected a (k, 3) array, got shape {a.shape}")
+    return a

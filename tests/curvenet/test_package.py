@@ -80,3 +80,11 @@ def test_backend_results_are_mesh_results():
     assert isinstance(res, PatchMeshResult) and isinstance(res, MeshResult)
     assert len(res.face_patch) == len(res.faces) and repr(res).startswith("<PatchMeshResult(")
     assert issubclass(FlowResult, MeshResult)
+
+
+def test_mesh_result_rejects_wrong_shapes():
+    # a backend that returns quads or a flat list has a bug: an internal error, not bad input
+    with pytest.raises(ValueError, match="faces") as exc:
+        MeshResult(np.zeros((4, 3)), [[0, 1, 2, 3]])
+    assert not isinstance(exc.value, curvenet.CurvenetError)
+    assert MeshResult([], []).faces.shape == (0, 3)
