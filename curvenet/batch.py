@@ -430,6 +430,8 @@ def run_batch(inputs, out_dir, options: BatchOptions | None = None, *, executor=
     if not inputs:
         raise InvalidParameterError("batch: no inputs")
     outputs = plan_outputs(inputs, out_dir, options.format)
+    if preview_dir is not None and Path(preview_dir).exists() and not Path(preview_dir).is_dir():
+        raise InvalidParameterError(f"--preview-dir {preview_dir}: is a file, not a folder")
     t0 = time.perf_counter()
     Path(out_dir).mkdir(parents=True, exist_ok=True)
     tiles_dir = None if preview_dir is None else Path(preview_dir)

@@ -302,7 +302,8 @@ def _cmd_surface_batch(args) -> int:
     if args.patches is not None:
         raise InvalidParameterError("surface: --patches applies to one input with -o, "
                                     "not to a batch")
-    report = None if args.report is None else check_report_path(args.report)
+    report = None if args.report is None else check_report_path(
+        args.report, inputs=args.inputs, out_dir=args.out_dir)
     executor = DaskExecutor(args.scheduler) if args.scheduler else LocalExecutor(args.jobs)
     options = _batch_options(args)
     bar = _progress(len(args.inputs), args.no_progress)
@@ -352,7 +353,8 @@ def _cmd_eval_pairs(args) -> int:
     from .tables import check_report_path, write_table
     if args.mesh is not None:
         raise InvalidParameterError("eval: give MESH REFERENCE or --pairs, not both")
-    report = None if args.report is None else check_report_path(args.report)
+    report = None if args.report is None else check_report_path(args.report,
+                                                                 inputs=args.pairs)
     if len(args.pairs) == 1:
         pairs = be.pairs_from_csv(args.pairs[0])
     elif len(args.pairs) == 2:

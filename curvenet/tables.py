@@ -11,9 +11,10 @@ from __future__ import annotations
 import csv
 import io
 import json
+import os
 from pathlib import Path
 
-from ._atomic import atomic_write_text
+from ._atomic import atomic_write_text, check_output_path
 from .errors import InvalidParameterError
 
 __all__ = ["write_table", "table_columns", "check_report_path", "REPORT_FORMATS"]
@@ -21,13 +22,19 @@ __all__ = ["write_table", "table_columns", "check_report_path", "REPORT_FORMATS"
 REPORT_FORMATS = (".csv", ".json")
 
 
-def check_report_path(path) -> Path:
-    """The report path, refused up front when its extension is neither .csv nor .json."""
+def check_report_path(path, *, inputs=(), out_dir=None) -> Path:
+    """The report path, checked before any work (:func:`curvenet._atomic.check_output_path`).
+
+    Refused: an extension other than .csv / .json, a folder, a missing or read-only
+    folder (except ``out_dir``, which the batch creates), one of ``inputs``.
+    """
     path = Path(path)
     if path.suffix.lower() not in REPORT_FORMATS:
         raise InvalidParameterError(f"--report {path}: use a .csv or .json file name")
     if path.is_dir():
         raise InvalidParameterError(f"--report {path}: is a folder")
+    if out_dir is None or os.path.abspath(path.parent) != os.path.abspath(out_dir):
+        check_output_path(path, inputs=inputs, what="--report")
     return path
 
 

@@ -89,6 +89,22 @@ def test_an_internal_error_in_one_file_does_not_stop_the_batch(tmp_path, capsys,
     assert "2 of 4 surfaced" in out and "1 internal failures" in out
 
 
+def test_report_and_preview_paths_are_checked_before_any_work(tmp_path, capsys):
+    box = _shapes(tmp_path / "in")[0]
+    out = tmp_path / "out"
+    base = ["surface", str(box), "--out-dir", str(out), "--method", "classical"]
+    assert main(base + ["--report", str(tmp_path / "nope" / "r.csv")]) == 2
+    assert main(base + ["--report", str(tmp_path / "r.txt")]) == 2
+    afile = tmp_path / "afile"
+    afile.write_text("x")
+    assert main(base + ["--preview-dir", str(afile)]) == 2
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 3 and "nope" in err[0] and "r.txt" in err[1] and "afile" in err[2]
+    assert not (out / "box.obj").exists()
+    assert main(base + ["--report", str(out / "r.csv")]) == 0  # inside the new out-dir
+    assert (out / "r.csv").is_file() and (out / "box.obj").is_file()
+
+
 # --------------------------------------------------------------------------- report
 def test_stroke_fidelity_is_the_share_of_stroke_length_on_the_surface():
     box = trimesh.creation.box()  # [-0.5, 0.5]^3, diagonal sqrt(3)
