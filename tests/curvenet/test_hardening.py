@@ -135,7 +135,7 @@ def test_hostile_json_is_bad_input(tmp_path, capsys, content, needle):
 
 
 def test_unreadable_input_is_bad_input(tmp_path, box_obj, capsys, monkeypatch):
-    import curvenet.io as cio
+    import curvenet._io_common as cio  # the module that opens sketch files
 
     def denied(path, *args, **kwargs):
         raise PermissionError(13, "Permission denied", str(path))

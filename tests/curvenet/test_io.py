@@ -147,7 +147,7 @@ def test_obj_junction_splits_chains_and_keeps_every_segment(tmp_path):
 
 def test_obj_fast_path_matches_token_parser(data_dir, tmp_path):
     """Oracle: the vectorised OBJ parser equals the token-by-token one on every data OBJ."""
-    from curvenet import io
+    from curvenet import _io_obj
 
     files = (sorted((data_dir / "networks").glob("*/*.obj"))
              + sorted((data_dir / "sketches" / "vns").rglob("*.obj")))
@@ -155,7 +155,7 @@ def test_obj_fast_path_matches_token_parser(data_dir, tmp_path):
     odd.write_text("v 0 0 0 1\n  v 1 0 0\nv\t2 0 0\n\tl 1 2 3\ng crease\nl 3/1/1 -2\n")
     for f in files + [odd]:
         text = f.read_text()
-        fast, slow = io._parse_obj(text, f), io._parse_obj_slow(text, f)
+        fast, slow = _io_obj.parse_obj(text, f), _io_obj.parse_obj_slow(text, f)
         np.testing.assert_array_equal(fast[0], slow[0])
         assert len(fast[1]) == len(slow[1])
         assert all(np.array_equal(a, b) for a, b in zip(fast[1], slow[1]))
