@@ -88,3 +88,14 @@ def test_mesh_result_rejects_wrong_shapes():
         MeshResult(np.zeros((4, 3)), [[0, 1, 2, 3]])
     assert not isinstance(exc.value, curvenet.CurvenetError)
     assert MeshResult([], []).faces.shape == (0, 3)
+
+
+def test_curvenet_is_the_only_top_level_name(tmp_path):
+    # run outside the checkout, so only what the installation provides is importable
+    code = ("import importlib.util, curvenet.neural, curvenet.surfacing; "
+            "print(importlib.util.find_spec('neural'), importlib.util.find_spec('surfacing'), "
+            "curvenet.neural.__name__, curvenet.surfacing.__name__)")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                       cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.split() == ["None", "None", "curvenet.neural", "curvenet.surfacing"]
