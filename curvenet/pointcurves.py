@@ -66,7 +66,7 @@ _MAX_DIM = 1.45             # highest correlation dimension read as curves
 _DIM_SLACK = 0.2            # radii this close to the lowest dimension are "one-dimensional"
 _CELL_FACTOR = 1.0         # cell size over the finest one-dimensional radius
 _MIN_CELL = 1.0 / 600.0     # smallest cell size, fraction of the diagonal (bounds node count)
-_SMOOTH_R, _LINK_R, _SPUR, _CLOSE_LEAF, _FAR, _MERGE, _CORNER_W = 2.0, 2.5, 4.0, 6.0, 12.0, 3.0, 3.0
+_SMOOTH_R, _LINK_R, _SPUR, _CLOSE_LEAF, _FAR, _MERGE, _CORNER_W = 2.0, 2.5, 4.0, 6.0, 12.0, 4.0, 4.0
 _CORNER_ANGLE = 45.0
 
 
@@ -250,35 +250,65 @@ def _tree_distance(n, tree_e, tree_w, a, b):
     return depth[a0] + depth[b0] - 2 * depth[lca]
 
 
+def _walk_back(n, e, start, hops):
+    """Node reached from each leaf in ``start`` after ``hops`` steps along its chain
+    (stopping early at a junction or an end)."""
+    g = _sym(n, e, np.ones(len(e)))
+    ptr, nbr = g.indptr, g.indices
+    deg = np.diff(ptr)
+    prev, cur = start.copy(), start.copy()
+    for _ in range(hops):  # loop over hops; every leaf walks at once
+        go = (deg[cur] == 1) & (cur == start) | (deg[cur] == 2)
+        first = nbr[ptr[cur]]
+        second = nbr[np.minimum(ptr[cur] + 1, len(nbr) - 1)]
+        nxt = np.where((first == prev) & (deg[cur] == 2), second, first)
+        prev, cur = np.where(go, cur, prev), np.where(go, nxt, cur)
+    return cur
+
+
 def _close_cycles(x, tree_e, tree_w, graph_e, c):
-    """Edges that close the cycles the spanning tree cut (shortest first, one per gap)."""
+    """Edges that close the cycles the spanning tree cut (cheapest first, one per gap).
+
+    Candidates join nodes more than ``_FAR * c`` apart along the tree: node-graph
+    edges between two non-leaf nodes (cost: length), and links from a leaf to a
+    node within ``_CLOSE_LEAF * c`` ahead of it, within 60 degrees of the
+    direction the leaf points in (cost: length over the cosine), so a curve cut
+    near a junction rejoins the junction, not a curve beside it.
+    """
     n = len(x)
-    alive = np.zeros(n, bool)
-    alive[tree_e.ravel()] = True
     deg = np.bincount(tree_e.ravel(), minlength=n)
-    leaves = np.flatnonzero(deg == 1)
-    cand = [graph_e[alive[graph_e[:, 0]] & alive[graph_e[:, 1]]]]
+    leaf = deg == 1
+    ok = (deg[graph_e[:, 0]] > 1) & (deg[graph_e[:, 1]] > 1)
+    cand, cost = [graph_e[ok]], [np.linalg.norm(x[graph_e[ok, 0]] - x[graph_e[ok, 1]], axis=1)]
+    leaves = np.flatnonzero(leaf)
     if len(leaves):
-        idx = np.flatnonzero(alive)
-        dist, nb = cKDTree(x[idx]).query(x[leaves], k=min(24, len(idx)),
-                                         distance_upper_bound=_CLOSE_LEAF * c)
-        ok = np.isfinite(dist)
-        cand.append(np.column_stack([np.broadcast_to(leaves[:, None], ok.shape)[ok],
-                                     idx[np.minimum(nb, len(idx) - 1)][ok]]))
-    cand = np.vstack(cand)
-    cand = cand[cand[:, 0] != cand[:, 1]]
+        idx = np.flatnonzero(deg > 0)
+        tree = cKDTree(x[idx])
+        k = min(24, len(idx))
+        dist, nb = tree.query(x[leaves], k=k, distance_upper_bound=_CLOSE_LEAF * c)
+        nb = idx[np.minimum(nb, len(idx) - 1)]
+        ahead = x[leaves] - x[_walk_back(n, tree_e, leaves, hops=4)]
+        ahead /= np.maximum(np.linalg.norm(ahead, axis=1, keepdims=True), 1e-300)
+        to = x[nb] - x[leaves][:, None, :]
+        cos = np.einsum("ijk,ik->ij", to, ahead) / np.maximum(dist, 1e-300)
+        good = np.isfinite(dist) & (cos >= 0.5)
+        cand.append(np.column_stack([np.broadcast_to(leaves[:, None], good.shape)[good],
+                                     nb[good]]))
+        cost.append(dist[good] / cos[good])
+    cand, cost = np.vstack(cand), np.concatenate(cost)
+    keep = cand[:, 0] != cand[:, 1]
+    cand, cost = cand[keep], cost[keep]
     if len(cand) == 0:
         return np.zeros((0, 2), np.int64)
     far = _tree_distance(n, tree_e, tree_w, cand[:, 0], cand[:, 1]) > _FAR * c
-    cand = cand[far]
-    length = np.linalg.norm(x[cand[:, 0]] - x[cand[:, 1]], axis=1)
-    cand, length = cand[np.argsort(length)], np.sort(length)
+    cand, cost = cand[far], cost[far]
+    cand = cand[np.argsort(cost, kind="stable")]
     added_e, added_w = [], []
     g = _sym(n, tree_e, tree_w)
-    for (a, b), ln in zip(cand, length):  # loop over gap candidates, not points
+    for a, b in cand:  # loop over gap candidates, not points
         if csgraph.dijkstra(g, indices=a, limit=_FAR * c)[b] > _FAR * c:
             added_e.append((a, b))
-            added_w.append(ln)
+            added_w.append(float(np.linalg.norm(x[a] - x[b])) + 1e-9 * c)
             g = _sym(n, np.vstack([tree_e, added_e]), np.concatenate([tree_w, added_w]))
     return np.asarray(added_e, np.int64).reshape(-1, 2)
 
@@ -459,8 +489,8 @@ def _corners(poly, w):
     """Indices of the corners of a polyline.
 
     A corner turns by more than :data:`_CORNER_ANGLE` between the directions
-    over ``[w / 3, w]`` before and after it, and by less than 1.5 times that
-    over ``[2 w / 3, 2 w]``: a corner's turn does not grow with the window
+    over ``[2 w / 3, 2 w]`` before and after it, and by less than 1.5 times the
+    turn over ``[w / 3, w]``: a corner's turn does not grow with the window
     (rounding by the sampling scale aside), a smooth bend's grows in proportion.
     """
     s = cumulative_length(poly)
@@ -478,7 +508,7 @@ def _corners(poly, w):
         return np.degrees(np.arccos(np.clip(cos, -1, 1)))
 
     turn, wide = turn(w), turn(2 * w)
-    turn = np.where(wide < 1.5 * turn, turn, 0.0)
+    turn = np.where(wide < 1.5 * turn, wide, 0.0)
     sharp = inside[turn > _CORNER_ANGLE]
     if len(sharp) == 0:
         return sharp
@@ -507,23 +537,25 @@ def _polylines(x, curves, cluster, c):
     where = {}
     for v in labels:
         members = np.flatnonzero(cluster == v)
-        ends = [cv[0] if cv[1] == v else cv[0][::-1] for cv in curves for k in (1, 2)
+        ends = [cv[0] if k == 1 else cv[0][::-1] for cv in curves for k in (1, 2)
                 if cv[k] == v]
         where[v] = _junction_point(x, members, ends, c)
     strokes, corners = [], 0
     for nodes, a, b in curves:
-        p = _smooth(x[nodes], closed=a < 0)
-        if a >= 0:
+        p = x[nodes]
+        closed = a < 0
+        if not closed:
             ja, jb = where[a], where[b]
             keep = ((np.linalg.norm(p - ja, axis=1) > c) & (np.linalg.norm(p - jb, axis=1) > c))
             keep[[0, -1]] = False
             p = np.vstack([ja, p[keep], jb])
-        cut = _corners(p, _CORNER_W * c) if a >= 0 or len(p) > 3 else np.zeros(0, np.int64)
-        if a < 0 and len(cut):  # closed loop with corners: start it at one
+        cut = _corners(p, _CORNER_W * c)
+        if closed and len(cut):  # closed loop with corners: start it at one
             p = np.vstack([p[cut[0]:-1], p[:cut[0] + 1]])
-            cut = _corners(p, _CORNER_W * c)
+            cut, closed = _corners(p, _CORNER_W * c), False
         corners += len(cut)
-        strokes.extend(p[i:j + 1] for i, j in zip(np.r_[0, cut], np.r_[cut, len(p) - 1]))
+        strokes.extend(_smooth(p[i:j + 1], closed)
+                       for i, j in zip(np.r_[0, cut], np.r_[cut, len(p) - 1]))
     return strokes, np.array([where[v] for v in labels]).reshape(-1, 3), corners
 
 
@@ -583,8 +615,8 @@ def recover_curves(points, *, cell: float | None = None, name: str = "points",
         sparse.coo_matrix((length, (pairs[:, 0], pairs[:, 1])), shape=(len(x),) * 2)).tocoo()
     tree = np.column_stack([mst.row, mst.col]).astype(np.int64)
     tree, spurs = _prune(x, tree, cell)
-    closing = _close_cycles(x, tree, np.linalg.norm(x[tree[:, 0]] - x[tree[:, 1]], axis=1),
-                            pairs, cell)
+    closing = _close_cycles(x, tree, np.linalg.norm(x[tree[:, 0]] - x[tree[:, 1]], axis=1)
+                            + 1e-9 * cell, pairs, cell)
     e, more = _prune(x, np.vstack([tree, closing]), cell, forks=True)
     curves, cluster, _ = _assemble(x, e, cell)
     strokes, junctions, corners = _polylines(x, curves, cluster, cell)
