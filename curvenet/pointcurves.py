@@ -59,6 +59,8 @@ __all__ = ["JUMP_RATIO", "MIN_BLOCK_POINTS", "NotCurvesError", "PointCurves", "j
 #: this many times the median nearest-neighbour spacing (drawn polylines: about 1).
 JUMP_RATIO = 8.0
 
+_PROBES = 200_000            # largest sample that neighbour statistics are taken on
+
 #: Blocks with fewer points are always read as polylines (too few to tell).
 MIN_BLOCK_POINTS = 20
 
@@ -113,12 +115,15 @@ def jump_ratio(points) -> float:
     -------
     float
         About 1 for a drawn polyline, about ``n / 3`` for points in random order.
+        Nearest neighbours are taken for at most :data:`_PROBES` points (seeded).
     """
     p = np.asarray(points, dtype=np.float64)
     if len(p) < 3:
         return 1.0
     steps = np.linalg.norm(np.diff(p, axis=0), axis=1)
-    d, _ = cKDTree(p).query(p, k=2, workers=-1)
+    probe = p if len(p) <= _PROBES else p[np.random.default_rng(0).choice(len(p), _PROBES,
+                                                                          replace=False)]
+    d, _ = cKDTree(p).query(probe, k=2)
     nn, steps = d[:, 1][d[:, 1] > 0], steps[steps > 0]
     if nn.size == 0 or steps.size == 0:
         return 1.0
@@ -139,7 +144,8 @@ def dimension_profile(points, *, probes: int = 2000, seed: int = 0) -> np.ndarra
     ----------
     points : (n, 3) array_like
     probes : int
-        Number of points (drawn at random, seeded) whose neighbour counts are taken.
+        Number of points (drawn at random, seeded) whose neighbour counts are
+        taken, among at most :data:`_PROBES` points (a seeded subsample).
     seed : int
 
     Returns
@@ -151,11 +157,13 @@ def dimension_profile(points, *, probes: int = 2000, seed: int = 0) -> np.ndarra
     """
     p = np.asarray(points, dtype=np.float64)
     diag = float(np.linalg.norm(np.ptp(p, axis=0))) or 1.0
-    probe = p if len(p) <= probes else p[np.random.default_rng(seed).choice(len(p), probes,
-                                                                           replace=False)]
+    rng = np.random.default_rng(seed)
+    other = p if len(p) <= _PROBES else p[rng.choice(len(p), _PROBES, replace=False)]
+    probe = other if len(other) <= probes else other[rng.choice(len(other), probes,
+                                                                replace=False)]
     radii = diag * 2.0 ** (-np.arange(2, 44) / 2)
-    counts = cKDTree(probe).count_neighbors(cKDTree(p), radii).astype(np.float64) - len(probe)
-    counts = counts / len(probe)
+    counts = cKDTree(probe).count_neighbors(cKDTree(other), radii).astype(np.float64)
+    counts = (counts - len(probe)) / len(probe)
     keep = np.flatnonzero(counts >= 1.0)
     if len(keep) < 3:
         return np.zeros((0, 2))
