@@ -296,9 +296,9 @@ def _close_cycles(x, tree_e, tree_w, graph_e, c):
         dist, nb = tree.query(x[leaves], k=k, distance_upper_bound=_CLOSE_LEAF * c)
         nb = idx[np.minimum(nb, len(idx) - 1)]
         ahead = x[leaves] - x[_walk_back(n, tree_e, leaves, hops=4)]
-        ahead /= np.maximum(np.linalg.norm(ahead, axis=1, keepdims=True), 1e-300)
+        ahead /= np.maximum(np.linalg.norm(ahead, axis=1, keepdims=True), DIVISION_GUARD)
         to = x[nb] - x[leaves][:, None, :]
-        cos = np.einsum("ijk,ik->ij", to, ahead) / np.maximum(dist, 1e-300)
+        cos = np.einsum("ijk,ik->ij", to, ahead) / np.maximum(dist, DIVISION_GUARD)
         good = np.isfinite(dist) & (cos >= 0.5)
         cand.append(np.column_stack([np.broadcast_to(leaves[:, None], good.shape)[good],
                                      nb[good]]))
