@@ -27,7 +27,8 @@ import networkx as nx
 import numpy as np
 
 from curvenet import shapes
-from curvenet.pointcurves import recover_curves, sample_curves
+from curvenet.pointcurves import recover_curves
+from curvenet.shapes import sample_curves
 from curvenet.sketch import Sketch
 from curvenet.snap import snap
 

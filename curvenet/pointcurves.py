@@ -53,7 +53,7 @@ from .sketch import Sketch
 
 __all__ = ["JUMP_RATIO", "MIN_BLOCK_POINTS", "NotCurvesError", "PointCurves", "jump_ratio",
            "dimension_profile",
-           "recover_curves", "read_point_blocks", "sample_curves"]
+           "recover_curves", "read_point_blocks"]
 
 #: A block is unordered when the median step between consecutive points exceeds
 #: this many times the median nearest-neighbour spacing (drawn polylines: about 1).
@@ -694,42 +694,3 @@ def read_point_blocks(sketch: Sketch, points="auto") -> Sketch:
                        + (f"; {n_poly} stroke(s) read as polylines" if n_poly else ""))
     meta["point_blocks"] = [dict(r, stroke=i) for i, _, _, r in blocks]
     return Sketch(strokes, labels, meta, src)
-
-
-def sample_curves(curves, spacing: float, *, noise: float = 0.0, uneven: float = 1.0,
-                  rng=None) -> np.ndarray:
-    """Unordered samples along polylines (test and benchmark inputs).
-
-    Parameters
-    ----------
-    curves : list of (k_i, 3) array_like
-        Polylines, e.g. ``[e.curve for e in network.edges]``.
-    spacing : float
-        Mean distance between consecutive samples along a curve.
-    noise : float
-        Root-mean-square length of the Gaussian displacement added to each
-        sample (each coordinate gets standard deviation ``noise / sqrt(3)``).
-    uneven : float
-        Ratio of the highest to the lowest sampling density along each curve
-        (``1``: uniform); the densest stretch sits at a random place.
-    rng : numpy.random.Generator or int, optional
-
-    Returns
-    -------
-    (N, 3) float64 ndarray
-        Shuffled samples.
-    """
-    rng = np.random.default_rng(rng)
-    a = (uneven - 1.0) / (uneven + 1.0)
-    out = []
-    for cv in curves:  # loop over curves; samples are vectorised
-        cv = np.asarray(cv, dtype=np.float64)
-        s = cumulative_length(cv)
-        n = max(2, int(round(s[-1] / spacing)))
-        u = (np.arange(n) + rng.uniform()) / n
-        phase = rng.uniform(0, 2 * np.pi)
-        t = u + a * (np.sin(2 * np.pi * u + phase) - np.sin(phase)) / (2 * np.pi)
-        out.append(interpolate_polyline(cv, t * s[-1], cum=s))
-    pts = np.concatenate(out)
-    pts = pts + rng.normal(0.0, noise / np.sqrt(3.0), pts.shape) if noise > 0 else pts
-    return rng.permutation(pts)

@@ -10,8 +10,8 @@ from curvenet.cli import main
 from curvenet.errors import SketchFormatError
 from curvenet.evaluate import evaluate_mesh
 from curvenet.io import read_sketch
-from curvenet.pointcurves import (JUMP_RATIO, NotCurvesError, jump_ratio, recover_curves,
-                                  sample_curves)
+from curvenet.pointcurves import JUMP_RATIO, NotCurvesError, jump_ratio, recover_curves
+from curvenet.shapes import sample_curves
 from curvenet.sketch import Sketch
 from curvenet.snap import snap
 
