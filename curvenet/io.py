@@ -17,6 +17,9 @@ Formats
 ``txt``
     ``x y z`` per line, a blank line between strokes; ``CURVE i`` header lines
     also start a new stroke (Neveu et al. 2022 data).
+``abc``
+    ABC dataset feature curves (``*_features_*.yml``): each curve evaluated at its
+    ``vert_parameters``; see :mod:`curvenet.abc_features`.
 ``json``
     The project's own format::
 
@@ -57,24 +60,27 @@ from pathlib import Path
 import numpy as np
 
 from ._atomic import atomic_write_text
-from ._io_common import MAX_ABS_COORDINATE, load_text
+from .abc_features import looks_like_abc, read_abc_features
+from ._io_common import MAX_ABS_COORDINATE, finish_sketch, load_text
 from ._io_obj import chain_segments, parse_obj, read_obj
 from ._io_text import read_blocks, read_json
 from .errors import SketchFormatError
 from .network import CurveNetwork, indexed_network
 from .sketch import Sketch
 
-__all__ = ["FORMATS", "MAX_FILE_BYTES", "read_sketch", "write_sketch", "write_network_obj",
-           "read_network_obj", "detect_format", "MAX_ABS_COORDINATE"]
+__all__ = ["FORMATS", "WRITE_FORMATS", "MAX_FILE_BYTES", "read_sketch", "write_sketch",
+           "write_network_obj", "read_network_obj", "detect_format", "MAX_ABS_COORDINATE"]
 
+#: Formats :func:`write_sketch` writes; :data:`FORMATS` adds the read-only ``abc``.
+WRITE_FORMATS = ("obj", "curves", "txt", "json")
 #: Supported format names.
-FORMATS = ("obj", "curves", "txt", "json")
+FORMATS = WRITE_FORMATS + ("abc",)
 
 #: Largest file :func:`read_sketch` accepts by default (1 GiB); pass ``max_bytes`` to change.
 MAX_FILE_BYTES = 1 << 30
 
 _EXTENSIONS = {".obj": "obj", ".curves": "curves", ".txt": "txt", ".xyz": "txt",
-               ".json": "json"}
+               ".json": "json", ".yml": "abc", ".yaml": "abc"}
 
 
 # --------------------------------------------------------------------------- public
@@ -104,6 +110,8 @@ def detect_format(path, text: str | None = None) -> str:
         raise SketchFormatError("no content to recognise", path=path)
     if first[0].startswith("{"):
         return "json"
+    if looks_like_abc(text):
+        return "abc"
     if "l" in heads and "v" in heads:
         return "obj"
     if first[0] == "v" and len(first) == 2:
@@ -127,9 +135,9 @@ def read_sketch(path, *, format: str | None = None, strict: bool = False,
     Parameters
     ----------
     path : str or os.PathLike
-    format : {'obj', 'curves', 'txt', 'json'}, optional
+    format : {'obj', 'curves', 'txt', 'json', 'abc'}, optional
         Defaults to the extension (``.obj``, ``.curves``, ``.txt``/``.xyz``,
-        ``.json``); other extensions are recognised by content.
+        ``.json``, ``.yml``/``.yaml``); other extensions are recognised by content.
     strict : bool
         Raise on a stroke with fewer than two points instead of dropping it.
     max_bytes : int
@@ -174,6 +182,9 @@ def read_sketch(path, *, format: str | None = None, strict: bool = False,
         sketch = read_obj(text, path, strict)
     elif fmt == "json":
         sketch = read_json(text, path, strict)
+    elif fmt == "abc":
+        strokes, labels, meta = read_abc_features(text, path)
+        sketch = finish_sketch(strokes, labels, [None] * len(strokes), path, strict, meta)
     else:
         sketch = read_blocks(text, path, strict, fmt)
     from .pointcurves import read_point_blocks
@@ -221,14 +232,15 @@ def _sketch_text(sketch: Sketch, fmt: str) -> str:
 
 
 def write_sketch(path, sketch: Sketch, *, format: str | None = None) -> None:
-    """Write a sketch atomically in one of :data:`FORMATS`.
+    """Write a sketch atomically in one of :data:`WRITE_FORMATS`.
 
     Parameters
     ----------
     path : str or os.PathLike
     sketch : Sketch
     format : {'obj', 'curves', 'txt', 'json'}, optional
-        Defaults to the extension; ``obj`` when the extension is unknown.
+        Defaults to the extension; ``obj`` when the extension is unknown (``abc``
+        is read-only).
 
     Notes
     -----
@@ -241,8 +253,9 @@ def write_sketch(path, sketch: Sketch, *, format: str | None = None) -> None:
     vertices).
     """
     fmt = format or _EXTENSIONS.get(Path(path).suffix.lower(), "obj")
-    if fmt not in FORMATS:
-        raise SketchFormatError(f"unknown format {fmt!r}; use one of {FORMATS}", path=path)
+    if fmt not in WRITE_FORMATS:
+        what = "read-only format" if fmt in FORMATS else "unknown format"
+        raise SketchFormatError(f"{what} {fmt!r}; use one of {WRITE_FORMATS}", path=path)
     atomic_write_text(path, _sketch_text(sketch, fmt))
 
 

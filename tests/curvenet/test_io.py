@@ -11,7 +11,7 @@ import pytest
 
 from curvenet import shapes
 from curvenet.errors import SketchFormatError
-from curvenet.io import (FORMATS, detect_format, read_network_obj, read_sketch,
+from curvenet.io import (WRITE_FORMATS, detect_format, read_network_obj, read_sketch,
                          write_network_obj, write_sketch)
 from curvenet.sketch import Sketch
 
@@ -31,7 +31,7 @@ def _write(tmp_path, name, text):
 
 
 # --------------------------------------------------------------------------- round trips
-@pytest.mark.parametrize("fmt", FORMATS)
+@pytest.mark.parametrize("fmt", WRITE_FORMATS)
 def test_round_trip_is_exact(tmp_path, fmt):
     sk = _sketch()
     p = tmp_path / f"s.{fmt}"
@@ -48,7 +48,7 @@ def test_round_trip_is_exact(tmp_path, fmt):
     assert (tmp_path / f"t.{fmt}").read_text() == p.read_text()
 
 
-@pytest.mark.parametrize("fmt", FORMATS)
+@pytest.mark.parametrize("fmt", WRITE_FORMATS)
 def test_round_trip_format_argument_and_sniffing(tmp_path, fmt):
     sk = _sketch(1, 4)
     p = tmp_path / "sketch.dat"
