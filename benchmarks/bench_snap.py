@@ -93,12 +93,44 @@ def data_table(root):
               f"{r['strokes_dropped_short']:4d} {dt:5.2f}")
 
 
+def patch_table(root, snap_tol=None):
+    """Patch count and coverage (curve length on patch edges) per public rough sketch."""
+    import warnings
+
+    from curvenet.io import read_sketch
+    from curvenet.pipeline import _coverage, patches
+
+    root = Path(root) / "sketches"
+    files = (sorted((root / "vns").rglob("*.obj"))
+             + sorted((root / "cassie" / "curves").glob("*.curves")))
+    print(f"{'file':44s} {'tol':>7s} {'V':>5s} {'E':>5s} {'patches':>7s} {'coverage':>8s}")
+    tot_p, tot_c = 0, 0.0
+    for f in files:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            sk = read_sketch(f)
+            ps = patches(sk, snap_tol=snap_tol)
+        cov, _ = _coverage(ps)
+        net = ps.network
+        tot_p += len(ps.patches)
+        tot_c += cov
+        print(f"{str(f.relative_to(root)):44s} {net.report.get('snap_tol', 0):7.4f} "
+              f"{net.number_of_vertices:5d} {net.number_of_edges:5d} {len(ps.patches):7d} "
+              f"{cov:8.3f}", flush=True)
+    print(f"{'total / mean':44s} {'':7s} {'':5s} {'':5s} {tot_p:7d} {tot_c / len(files):8.3f}")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--data", metavar="DIR", help="print per-file statistics for the public "
                     "data folder (e.g. ../shared/data) instead of timing")
+    ap.add_argument("--patches", metavar="DIR", help="print patch count and coverage per "
+                    "public rough sketch under DIR/sketches instead of timing")
     args = ap.parse_args(argv)
+    if args.patches:
+        patch_table(args.patches)
+        return
     if args.data:
         data_table(args.data)
         return

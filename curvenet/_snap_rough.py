@@ -10,6 +10,7 @@ import numpy as np
 from scipy.ndimage import maximum_filter1d
 from scipy.spatial import cKDTree
 
+from ._snap_auto import check_density
 from .core.geometry import arc_length, cumulative_length, interpolate_polyline, resample_polyline
 from .core.tolerances import DIVISION_GUARD
 from .network import CurveNetwork
@@ -670,6 +671,8 @@ def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
     # overdraw first: it changes the strokes the junctions are found on
     for _round in range(12):
         samples = _sample(st, h)
+        if _round == 0:
+            check_density(samples, tol, opts.snap_tol)
         con = _contacts(samples, tol, h, st, opts)
         if not con["overlap"].any():
             break

@@ -21,6 +21,11 @@ from .errors import CurvenetError, InvalidParameterError, OutputError
 __all__ = ["main", "build_parser"]
 
 
+def _snap_tol(text: str) -> float | str:
+    """``--snap-tol``: ``auto`` (choose from the sketch) or a fraction of the diagonal."""
+    return "auto" if text.strip().lower() == "auto" else _fraction(text)
+
+
 def _fraction(text: str) -> float:
     try:
         value = float(text)
@@ -85,13 +90,16 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("snap", help="snap rough strokes into a curve network (NETWORK.json)")
     s.add_argument("input")
     s.add_argument("-o", "--output", required=True, help="NETWORK.json (or .obj polylines)")
-    s.add_argument("--snap-tol", type=_fraction, help="fraction of the bbox diagonal")
+    s.add_argument("--snap-tol", type=_snap_tol, default="auto",
+                   help="fraction of the bbox diagonal, or auto (default: chosen from the "
+                        "sketch, the choice and why printed)")
     s.add_argument("--points", action="store_true", help=_POINTS_HELP)
 
     s = sub.add_parser("patches", help="find surface patches (PATCHES.json)")
     s.add_argument("input", help="sketch file or NETWORK.json")
     s.add_argument("-o", "--output", required=True, help="PATCHES.json")
-    s.add_argument("--snap-tol", type=_fraction)
+    s.add_argument("--snap-tol", type=_snap_tol, default="auto",
+                   help="fraction of the bbox diagonal, or auto (default)")
     s.add_argument("--close", choices=("auto", "none"), default="auto",
                    help="accept solid-closing patches automatically (default auto)")
     s.add_argument("--points", action="store_true", help=_POINTS_HELP)
@@ -123,7 +131,8 @@ def build_parser() -> argparse.ArgumentParser:
                         "classical: the --surfacer on the patches; or a surfacer: "
                         + "; ".join(f"{n}: {get_surfacer(n).summary}" for n in surfacer_names()))
     s.add_argument("--patches", metavar="PATCHES.json", help="use this (edited) patch set")
-    s.add_argument("--snap-tol", type=_fraction)
+    s.add_argument("--snap-tol", type=_snap_tol, default="auto",
+                   help="fraction of the bbox diagonal, or auto (default)")
     s.add_argument("--close", choices=("auto", "none"), default="auto")
     s.add_argument("--points", action="store_true", help=_POINTS_HELP)
     s.add_argument("--surfacer", choices=surfacer_names("patches"), default="catmull-clark",
@@ -171,7 +180,7 @@ def _cmd_snap(args) -> int:
     from .snap import snap
     check_output_path(args.output, inputs=[args.input], what="-o")
     sketch = read_sketch(args.input, points=_points(args))
-    net = snap(sketch, **({} if args.snap_tol is None else {"snap_tol": args.snap_tol}))
+    net = snap(sketch, snap_tol=args.snap_tol)
     if net.number_of_edges == 0:
         raise CurvenetError(f"{args.input}: snapping left no curves (every stroke collapsed "
                             "to a point)")
@@ -179,9 +188,8 @@ def _cmd_snap(args) -> int:
         write_network_obj(args.output, net)
     else:
         save_network(args.output, net)
-    rep = ", ".join(f"{k} {v}" for k, v in net.report.items() if isinstance(v, (int, float)))
-    print(f"{args.output}: {net.number_of_vertices} vertices, {net.number_of_edges} curves"
-          + (f" ({rep})" if rep else ""))
+    print(f"{args.output}: {net.number_of_vertices} vertices, {net.number_of_edges} curves")
+    print(net.report["summary"])
     if sketch.metadata.get("point_blocks"):
         print(f"reading: {sketch.metadata['reading']}")
     return 0
@@ -238,7 +246,8 @@ def _surface_one(inp: str, out: str, args) -> dict:
         return {"input": inp, "output": out, "status": "ok", "method": res.method,
                 "faces": len(res.mesh.faces), "seconds": time.perf_counter() - t0,
                 "why": res.decision.explain(), "interrupted": res.interrupted,
-                "reading": res.diagnostics.get("reading", "")}
+                "reading": res.diagnostics.get("reading", ""),
+                "snap": res.diagnostics.get("snap", {}).get("summary", "")}
     except CurvenetError as err:
         return {"input": inp, "output": out, "status": "error", "error": _naming(err, inp),
                 "seconds": time.perf_counter() - t0}
@@ -271,6 +280,8 @@ def _cmd_surface(args) -> int:
     if args.explain:
         if row.get("reading"):
             print(f"reading: {row['reading']}")
+        if row["snap"]:
+            print(row["snap"])
         print(f"route: {row['why']}")
     return 130 if row["interrupted"] else 0
 

@@ -141,15 +141,15 @@ def _network(sketch, patchset, *, snap_tol, timings):
         return patchset.network
     from .snap import snap
     t = time.perf_counter()
-    kwargs = {} if snap_tol is None else {"snap_tol": snap_tol}
-    net = snap(sketch, **kwargs)
+    net = snap(sketch, snap_tol=snap_tol)
     timings["snap"] = time.perf_counter() - t
     if "reading" in sketch.metadata:
         net.report["reading"] = sketch.metadata["reading"]
     return net
 
 
-def patches(source, *, snap_tol: float | None = None, close: str = "auto", points="auto",
+def patches(source, *, snap_tol: float | str | None = "auto", close: str = "auto",
+            points="auto",
             **options) -> PatchSet:
     """Snap (when given a sketch) and find patches.
 
@@ -158,8 +158,9 @@ def patches(source, *, snap_tol: float | None = None, close: str = "auto", point
     source : Sketch, CurveNetwork, str or os.PathLike
         A sketch or a ``NETWORK.json`` / ``PATCHES.json`` file (its patches are
         recomputed).
-    snap_tol : float, optional
-        Snapping tolerance as a fraction of the bounding-box diagonal.
+    snap_tol : float or "auto"
+        Snapping tolerance as a fraction of the bounding-box diagonal, or
+        ``"auto"`` (default; ``None`` means the same): see :func:`curvenet.snap.snap`.
     close : {"auto", "none"}
         Accept closing patches automatically (see :func:`curvenet.cycles.find_patches`).
     points : {"auto", True, False}
@@ -346,7 +347,8 @@ def _surface_route(plan: _Plan, decision: RouteDecision, settings: SurfaceSettin
 
 
 def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
-            snap_tol: float | None = None, close: str = "auto", surfacer: str = "catmull-clark",
+            snap_tol: float | str | None = "auto", close: str = "auto",
+            surfacer: str = "catmull-clark",
             subdiv: int | None = None, resolution: int | None = None,
             crease_angle: float = 30.0, refine: bool = False, quality: str = "draft",
             device: str = "cpu", seed: int = 0, progress: bool = False,
@@ -366,8 +368,9 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
         ``"classical"`` (the ``surfacer``), or any name of :func:`surfacers.surfacer_names`.
     patchset : PatchSet, optional
         Use these patches (e.g. an edited ``PATCHES.json``) instead of finding them.
-    snap_tol : float, optional
-        Snapping tolerance (fraction of the bounding-box diagonal).
+    snap_tol : float or "auto"
+        Snapping tolerance (fraction of the bounding-box diagonal), or ``"auto"``
+        (default): see :func:`curvenet.snap.snap`.
     close : {"auto", "none"}
         Closing-patch policy of the patch finder.
     surfacer : str

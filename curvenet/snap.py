@@ -58,7 +58,7 @@ one piece there; an end touching its own stroke's interior is not snapped.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -69,7 +69,8 @@ from ._snap_rough import UnionFind, dedup
 from .network import CurveNetwork, indexed_network
 from .sketch import Sketch
 
-__all__ = ["SnapOptions", "DEFAULT_SNAP_TOL", "snap", "prune_dangling", "dangling_vertices"]
+__all__ = ["SnapOptions", "DEFAULT_SNAP_TOL", "snap", "prune_dangling", "dangling_vertices",
+           "summary_line"]
 
 #: Default snapping tolerance, a fraction of the bounding-box diagonal. Chosen so
 #: that rough redraws (0.3% wobble, ends off by up to 1.5%, 1% gaps) snap
@@ -92,8 +93,9 @@ class SnapOptions:
 
     Attributes
     ----------
-    snap_tol : float
-        Fraction of the bounding-box diagonal (default :data:`DEFAULT_SNAP_TOL`).
+    snap_tol : float or "auto"
+        Fraction of the bounding-box diagonal, or ``"auto"`` (the default): chosen
+        from the sketch (see :mod:`curvenet._snap_auto`).
     corner_angle : float
         Degrees; a turn sharper than this within a stroke is a degree-2 vertex,
         and two stroke ends meeting at a sharper angle stay a vertex.
@@ -112,7 +114,7 @@ class SnapOptions:
     mode : {'auto', 'rough', 'exact'}
     """
 
-    snap_tol: float = DEFAULT_SNAP_TOL
+    snap_tol: float | str = "auto"
     corner_angle: float = 45.0
     corner_window: float = 1.5
     trim: float = 2.0
@@ -124,7 +126,8 @@ class SnapOptions:
 
     def validate(self) -> "SnapOptions":
         """Raise :class:`InvalidParameterError` naming any out-of-range option."""
-        check_snap_tol(self.snap_tol)
+        if self.snap_tol != "auto":
+            check_snap_tol(self.snap_tol)
         if not 0 < self.corner_angle <= 180:
             raise InvalidParameterError(f"corner_angle must be in (0, 180] degrees, "
                                         f"got {self.corner_angle!r}")
@@ -210,7 +213,7 @@ def _snap_exact(strokes, src, labels, diag):
     return net
 
 
-def snap(sketch: Sketch, *, snap_tol: float = DEFAULT_SNAP_TOL, corner_angle: float = 45.0,
+def snap(sketch: Sketch, *, snap_tol: float | str | None = "auto", corner_angle: float = 45.0,
          options: SnapOptions | None = None, **kwargs) -> CurveNetwork:
     """Snap a sketch's strokes into a curve network.
 
@@ -218,9 +221,14 @@ def snap(sketch: Sketch, *, snap_tol: float = DEFAULT_SNAP_TOL, corner_angle: fl
     ----------
     sketch : Sketch
         ``construction`` strokes are ignored; ``crease`` labels go to the edges.
-    snap_tol : float
+    snap_tol : float or "auto"
         Snapping distance as a fraction of the bounding-box diagonal of the
-        boundary and crease strokes (default :data:`DEFAULT_SNAP_TOL` = 0.025).
+        boundary and crease strokes. ``"auto"`` (the default; ``None`` means
+        the same) chooses it from the sketch: above the distances at which
+        stroke ends nearly meet another stroke, below those of free ends and
+        below half the spacing of parallel strokes, never under
+        :data:`DEFAULT_SNAP_TOL` = 0.025 unless that spacing requires it
+        (:mod:`curvenet._snap_auto`). ``report["snap_tol_reason"]`` says why.
     corner_angle : float
         Turn (degrees, default 45) above which a stroke gets a degree-2 corner
         vertex and two stroke ends meeting stay a vertex. The paper gives no
@@ -280,13 +288,16 @@ def snap(sketch: Sketch, *, snap_tol: float = DEFAULT_SNAP_TOL, corner_angle: fl
     if unknown:
         raise InvalidParameterError(f"unknown snap option(s) {sorted(unknown)}; "
                                     f"use {sorted(fields)}")
-    if options is None or snap_tol != DEFAULT_SNAP_TOL:
+    if snap_tol is None:
+        snap_tol = "auto"
+    if options is None or snap_tol != "auto":
         fields["snap_tol"] = snap_tol
     if options is None or corner_angle != 45.0:
         fields["corner_angle"] = corner_angle
     fields.update(kwargs)
     try:
-        opts = SnapOptions(**{k: (float(v) if k != "mode" else v)
+        opts = SnapOptions(**{k: (v if k == "mode" or (k == "snap_tol" and v == "auto")
+                                  else float(v))
                               for k, v in fields.items()}).validate()
     except (TypeError, ValueError) as err:
         if isinstance(err, InvalidParameterError):
@@ -299,21 +310,64 @@ def snap(sketch: Sketch, *, snap_tol: float = DEFAULT_SNAP_TOL, corner_angle: fl
     if mode == "auto":
         mode = "exact" if _is_exact(strokes, diag) else "rough"
     if mode == "exact":
+        why = "exact: every stroke end coincides with another stroke (no tolerance)"
+        opts = replace(opts, snap_tol=0.0 if opts.snap_tol == "auto" else opts.snap_tol)
         net = _snap_exact(strokes, src, labels, diag)
-        net.report.update(_common_report(net, diag, opts, len(strokes), dropped))
+        net.report.update(_common_report(net, diag, opts, len(strokes), dropped, why))
         return net
-    from ._snap_rough import snap_rough
-    net = snap_rough(strokes, src, labels, diag, opts)
+    if opts.snap_tol == "auto":
+        net, opts, why = _snap_auto(strokes, src, labels, diag, opts)
+    else:
+        from ._snap_rough import snap_rough
+        net, why = snap_rough(strokes, src, labels, diag, opts), "given"
     present = {s for e in net.edges for s in e.strokes}
     net.report["strokes_trimmed_away"] = (sum(1 for s in src if s not in present)
                                           - net.report["strokes_dropped_short"])
     net.report["strokes_dropped_short"] += dropped
-    net.report.update(_common_report(net, diag, opts, len(strokes), None))
+    net.report.update(_common_report(net, diag, opts, len(strokes), None, why))
     return net
 
 
-def _common_report(net, diag, opts, used, dropped):
+def _snap_auto(strokes, src, labels, diag, opts):
+    """Rough snapping at the tolerance the sketch suggests, arbitrated by the result.
+
+    The tolerance measured by :func:`curvenet._snap_auto.auto_tolerance` replaces
+    :data:`DEFAULT_SNAP_TOL` only if the network it gives is structurally no
+    worse and better in one respect: no fewer independent cycles (the cycle
+    rank, an upper bound on the patches) and no more dangling ends. A larger
+    tolerance that merges small features loses cycles and is refused; a smaller
+    one that leaves gaps open adds dangling ends and is refused.
+
+    Returns (network, options with the tolerance used, reason).
+    """
+    from ._snap_auto import SketchTooDense, auto_tolerance
+    from ._snap_rough import snap_rough
+    tol, why = auto_tolerance(strokes, diag, DEFAULT_SNAP_TOL)
+    base = replace(opts, snap_tol=DEFAULT_SNAP_TOL)
+    if tol == DEFAULT_SNAP_TOL:
+        return snap_rough(strokes, src, labels, diag, base), base, f"auto: {why}"
+    cand = replace(opts, snap_tol=tol)
+    net_c = snap_rough(strokes, src, labels, diag, cand)
+    try:
+        net_0 = snap_rough(strokes, src, labels, diag, base)
+    except SketchTooDense:
+        return net_c, cand, f"auto: {why}; the default is too dense to snap"
+
+    def score(net):
+        deg = np.bincount(net.endpoints.ravel(), minlength=net.number_of_vertices)
+        return net.cycle_rank(), int((deg == 1).sum())
+
+    (r_c, d_c), (r_0, d_0) = score(net_c), score(net_0)
+    if r_c > r_0 and d_c <= d_0:
+        return net_c, cand, (f"auto: {why}; against the default {DEFAULT_SNAP_TOL:.1%}: "
+                             f"cycles {r_0} -> {r_c}, dangling ends {d_0} -> {d_c}")
+    return net_0, base, (f"auto: default; {tol:.2%} was measured ({why}) but gives cycles "
+                         f"{r_0} -> {r_c}, dangling ends {d_0} -> {d_c}")
+
+
+def _common_report(net, diag, opts, used, dropped, why):
     rep = {"tol": opts.snap_tol * diag, "diagonal": diag, "snap_tol": opts.snap_tol,
+           "snap_tol_reason": why,
            "vertices": net.number_of_vertices, "edges": net.number_of_edges}
     deg = np.bincount(net.endpoints.ravel(), minlength=net.number_of_vertices)
     dv = np.flatnonzero(deg == 1)
@@ -324,7 +378,22 @@ def _common_report(net, diag, opts, used, dropped):
     if dropped is not None:
         rep["strokes_dropped_short"] = dropped
     rep.setdefault("warnings", net.report.get("warnings", []))
+    rep["summary"] = summary_line({**net.report, **rep})
     return rep
+
+
+def summary_line(report: dict) -> str:
+    """One line saying what snapping did: tolerance and why, junctions, merges, dangling ends."""
+    r = report
+    if r.get("mode") == "exact":
+        tol = r["snap_tol_reason"]
+    else:
+        tol = f"tolerance {r['snap_tol']:.2%} of the diagonal ({r['snap_tol_reason']})"
+    merges = (f"{r.get('gap_merges', 0)} gaps closed, {r.get('t_junctions', 0)} T-junctions, "
+              f"{r.get('crossings', 0)} crossings, {r.get('overdraw_consolidations', 0)} "
+              f"overdraws merged, {r.get('trimmed_overshoots', 0)} overshoots trimmed")
+    return (f"snap: {tol}; {r['vertices']} vertices, {r['edges']} curves, "
+            f"{r['junctions']} junctions; {merges}; {r['dangling_ends']} dangling ends")
 
 
 def dangling_vertices(network: CurveNetwork) -> np.ndarray:

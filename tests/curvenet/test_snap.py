@@ -248,7 +248,9 @@ def test_options_object():
     b = line([0, -0.8, 0.1], [0, 0.8, 0.1])  # 0.1 apart: beyond 0.025 * 2.83, within 0.05 * 2.83
     assert snap(sk(a, b)).report["junctions"] == 0
     assert snap(sk(a, b), options=opts).report["junctions"] == 1
-    assert snap(sk(a, b), options=opts, snap_tol=DEFAULT_SNAP_TOL).report["snap_tol"] == 0.05
+    assert snap(sk(a, b), options=opts, snap_tol="auto").report["snap_tol"] == 0.05
+    given = snap(sk(a, b), options=opts, snap_tol=DEFAULT_SNAP_TOL)
+    assert given.report["snap_tol"] == DEFAULT_SNAP_TOL
 
 
 # --------------------------------------------------------------------------- clean networks
