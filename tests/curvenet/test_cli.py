@@ -154,3 +154,20 @@ def test_out_of_range_neural_setting_names_it(tmp_path, box_obj, capsys):
     rc = main(["surface", str(box_obj), "-o", str(tmp_path / "m.obj"), "--method", "neural",
                "--no-progress", "--neural-set", "res=2"])
     assert rc != 0 and "res" in capsys.readouterr().err
+
+
+def test_snap_and_explain_print_the_snapping_line(tmp_path):
+    """`snap` prints one line on what snapping did; `--snap-tol auto` is the default,
+    a number overrides it; `surface --explain` shows the same line."""
+    from curvenet.redraw import rough_sketch
+    rough = tmp_path / "rough.obj"
+    write_sketch(rough, rough_sketch(shapes.box().network, seed=0))
+    r = run("snap", rough, "-o", tmp_path / "n.json")
+    assert r.returncode == 0, r.stderr
+    line = r.stdout.splitlines()[-1]
+    assert line.startswith("snap: tolerance") and "auto" in line and "dangling ends" in line
+    r = run("snap", rough, "-o", tmp_path / "m.json", "--snap-tol", "0.03")
+    assert "tolerance 3.00% of the diagonal (given)" in r.stdout
+    r = run("surface", rough, "-o", tmp_path / "s.obj", "--method", "classical", "--explain")
+    assert r.returncode == 0, r.stderr
+    assert any(x.startswith("snap: tolerance") for x in r.stdout.splitlines())
