@@ -22,8 +22,9 @@ How the tolerance is chosen
 3. **Parallel strokes.** For samples every ``1%`` of the diagonal, the distance
    to the second nearest other stroke running parallel beside it (tangents
    within 25 degrees, offset mostly across the tangent): a line of a grid has
-   parallel neighbours on both sides, an overdrawn curve has one copy on top. The median over all samples is the
-   spacing of the sketch's parallel curves (a dense grid's cell size). The
+   parallel neighbours on both sides, an overdrawn curve has one copy on top.
+   The median over all samples is the spacing of the sketch's parallel curves
+   (a dense grid's cell size). The
    tolerance is capped at :data:`_CAP` times it, so that neighbouring grid
    lines are never taken as one curve drawn twice, nor their junctions merged.
 """
