@@ -120,6 +120,69 @@ def patch_table(root, snap_tol=None):
     print(f"{'total / mean':44s} {'':7s} {'':5s} {'':5s} {tot_p:7d} {tot_c / len(files):8.3f}")
 
 
+def big_inputs(folder):
+    """Write the two big inputs of issue 20 into ``folder``; returns their paths.
+
+    ``rings.json``: 4,000 latitude rings of 400 points on the unit sphere (about 62 MB of
+    JSON; the rings are open by one sample spacing, so snapping takes the tolerance
+    path). ``scribbles.txt``: 7,000 random smooth strokes of 1,000 points in the unit cube
+    (7M points, about 200 MB of text).
+    """
+    from curvenet.io import write_sketch
+    folder = Path(folder)
+    rng = np.random.default_rng(0)
+    lat = np.linspace(-1.55, 1.55, 4000)[:, None]
+    t = np.linspace(0.0, 2 * np.pi, 400, endpoint=False)[None, :]  # not closed exactly
+    rings = np.stack([np.cos(lat) * np.cos(t), np.cos(lat) * np.sin(t),
+                      np.sin(lat) + 0 * t], axis=-1)
+    write_sketch(folder / "rings.json", Sketch(list(np.round(rings, 6))))
+    s = np.linspace(0.0, 1.0, 1000)[None, :, None]
+    c, a, b = (rng.uniform(0, 1, (7000, 1, 3)), rng.normal(size=(7000, 1, 3)) * 0.3,
+               rng.normal(size=(7000, 1, 3)) * 0.3)
+    scribbles = c + a * np.sin(np.pi * s) + b * np.sin(2 * np.pi * s + 1.0) * s
+    write_sketch(folder / "scribbles.txt", Sketch(list(np.round(scribbles, 5))))
+    return [folder / "rings.json", folder / "scribbles.txt"]
+
+
+_CHILD = """
+import resource, sys, time
+resource.setrlimit(resource.RLIMIT_AS, (int(sys.argv[2]) << 30, int(sys.argv[2]) << 30))
+from curvenet.errors import CurvenetError
+from curvenet.io import read_sketch
+from curvenet.snap import snap
+t = time.perf_counter()
+try:
+    net = snap(read_sketch(sys.argv[1]))
+    out = f"ok: {net.number_of_vertices} vertices, {net.number_of_edges} curves; " \
+          + net.report["snap_tol_reason"][:90]
+except CurvenetError as err:
+    out = f"refused: {err}"[:160]
+except MemoryError:
+    out = "MemoryError"
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20
+print(f"{time.perf_counter() - t:.1f}|{peak:.2f}|{out}")
+"""
+
+
+def big_table(folder, cap_gb=5):
+    """Read and snap each big input in a child process; its peak memory (RSS) and seconds.
+
+    The child's address space is capped at ``cap_gb`` GiB (``RLIMIT_AS``) so a run that
+    would need more ends with MemoryError instead of swapping a shared machine.
+    """
+    import subprocess
+    import sys
+
+    print(f"{'input':16s} {'MB':>6s} {'peak GB':>8s} {'sec':>7s}  result")
+    for f in big_inputs(folder):
+        r = subprocess.run([sys.executable, "-c", _CHILD, str(f), str(cap_gb)],
+                           capture_output=True, text=True)
+        last = (r.stdout.strip().splitlines() or ["-|-|" + r.stderr.strip()[-120:]])[-1]
+        sec, peak, out = last.split("|", 2)
+        print(f"{f.name:16s} {f.stat().st_size / 1e6:6.0f} {peak:>8s} {sec:>7s}  {out}",
+              flush=True)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
@@ -127,7 +190,12 @@ def main(argv=None):
                     "data folder (e.g. ../shared/data) instead of timing")
     ap.add_argument("--patches", metavar="DIR", help="print patch count and coverage per "
                     "public rough sketch under DIR/sketches instead of timing")
+    ap.add_argument("--big", metavar="TMPDIR", help="write the two big inputs of issue 20 "
+                    "into TMPDIR and print peak memory and time of snapping each")
     args = ap.parse_args(argv)
+    if args.big:
+        big_table(args.big)
+        return
     if args.patches:
         patch_table(args.patches)
         return

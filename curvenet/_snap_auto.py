@@ -43,6 +43,7 @@ AUTO_MAX = 0.06
 _STEP = 0.002          # resampling step of the measurements, fraction of the diagonal
 _PAR_STEP = 0.01       # spacing of the parallel-distance probes, fraction of the diagonal
 _MAX_POINTS = 1_000_000
+_MAX_PROBES = 20_000   # parallel-distance probes at most (evenly spread)
 _K = 48                # neighbours looked at per query
 _MIN_RATIO = 1.5       # smallest jump that separates joins from free ends
 _PAR_COS = np.cos(np.radians(25.0))
@@ -95,7 +96,8 @@ def auto_tolerance(strokes, diag, default):
     d_end = np.minimum(d_end, np.where(np.concatenate([closed, closed]),
                                        np.concatenate([own, own]), np.inf)) / diag
     # 3. parallel spacing
-    probe = np.arange(0, len(Q), max(1, int(round(_PAR_STEP * diag / h))))
+    step = max(int(round(_PAR_STEP * diag / h)), len(Q) // _MAX_PROBES, 1)
+    probe = np.arange(0, len(Q), step)
     k = min(2 * _K, len(Q))
     pd, pn = tree.query(Q[probe], k=k, distance_upper_bound=reach)
     pd, pn = pd.reshape(len(probe), k), pn.reshape(len(probe), k)

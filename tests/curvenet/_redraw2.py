@@ -14,7 +14,9 @@ every network edge as its own stroke, this one draws the way people sketch:
   may overshoot the corner and come back (a hook, 0.3-1% of the diagonal).
 * **Splits anywhere.** Each chain is split at uniformly random arc positions
   (about one split per diagonal length), with a gap of ``U(0, gap)`` times the
-  diagonal (an overlap in a quarter of the cases).
+  diagonal (an overlap in a quarter of the cases). Every piece is at least 5%
+  of the diagonal long: snapping drops strokes shorter than its tolerance as
+  noise, so a shorter piece would widen the gap it sits in.
 * **Ends short or long.** Open stroke ends stop short of or run past their end
   vertex by ``U(-ends, ends)`` times the diagonal; a closed stroke's ends gap or
   overlap by the same.
@@ -216,9 +218,9 @@ def redraw2(network, *, seed, gap=0.015, ends=0.012, wobble=0.003, split_rate=1.
         n_split = rng.poisson(split_rate * (b - a) / diag)
         cuts = np.sort(rng.uniform(a, b, n_split))
         pieces, lo = [], a
-        for c in cuts:  # every piece at least 2% of the diagonal long
+        for c in cuts:  # every piece at least 5% of the diagonal long (see the docstring)
             g = rng.uniform(0, gap) * diag * (1 if rng.random() < 0.75 else -0.5)
-            if min(c - 0.5 * g - lo, b - c - 0.5 * g) > 0.02 * diag:
+            if min(c - 0.5 * g - lo, b - c - 0.5 * g) > 0.05 * diag:
                 pieces.append((lo, c - 0.5 * g))
                 lo = c + 0.5 * g
         pieces.append((lo, b))

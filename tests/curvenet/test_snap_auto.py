@@ -24,12 +24,9 @@ def _rate(name, seeds, gap):
 
 @pytest.mark.parametrize("name", SHAPES)
 def test_independent_redraw_recovers_graph_ci(name):
-    """6 seeded redraws per shape (gaps up to 1.5% of the diagonal), auto tolerance.
-
-    The floor is what snapping achieves today (issue 16 asks for 95%; the
-    measured rates per shape are in benchmarks/README.md).
-    """
-    assert _rate(name, range(6), 0.015) >= 4 / 6
+    """6 seeded redraws per shape (gaps up to 1.5% of the diagonal), auto tolerance:
+    at most one miss (the 20-seed rates per shape are in benchmarks/README.md)."""
+    assert _rate(name, range(6), 0.015) >= 5 / 6
 
 
 def test_generator_is_independent_and_valid():
