@@ -34,6 +34,7 @@ from .candidates import (DEFAULT_MAX_WORK, ENGINES, NUMBA_MIN_WORK, SEPARATING_E
                          Candidate, CandidatePool)
 from .closing import auto_close, closing_suggestions
 from .errors import InvalidParameterError
+from .holes import hole_patches
 from .loops import cycle_to_loop, orient_patches
 from .network import CurveNetwork
 from .patchset import Patch, PatchSet
@@ -59,7 +60,7 @@ def _validate(network, close, tie_break, max_cycle_length, max_work):
 
 def find_patches(network: CurveNetwork, *, close: str = "auto", tie_break: str = "pca",
                  max_cycle_length=None, max_work: int = DEFAULT_MAX_WORK,
-                 engine: str = "auto", genus_aware: bool = True) -> PatchSet:
+                 engine: str = "auto", genus_aware: bool = True, holes: bool = True) -> PatchSet:
     """Find surface patches: minimum-weight GF(2) cycle basis plus closing patches.
 
     Parameters
@@ -92,6 +93,10 @@ def find_patches(network: CurveNetwork, *, close: str = "auto", tie_break: str =
         ``k`` (and, with ``close="auto"``, left out of the patches), and keep
         that result when it is closer to a 2-manifold (see Notes). ``False``:
         the paper's order only.
+    holes : bool
+        Make nested coplanar patches holes of the face around them
+        (:func:`curvenet.holes.hole_patches`; beyond the paper, whose basis
+        holds only simple cycles). ``False``: every patch is a disc.
 
     Returns
     -------
@@ -103,7 +108,9 @@ def find_patches(network: CurveNetwork, *, close: str = "auto", tie_break: str =
         that were independent when their turn came), ``max_length``, ``work``,
         ``work_bound_hit``, ``horton_candidates``, ``closing_added`` (edge
         lists), ``tie_break``, ``close``, ``timings`` (``{"patches": seconds}``) and
-        ``patch_stages`` (seconds for ``setup``, ``basis``, ``closing``).
+        ``patch_stages`` (seconds for ``setup``, ``basis``, ``closing``) and
+        ``holes`` (which loops became holes of which patch, see
+        :func:`curvenet.holes.hole_patches`).
 
     Raises
     ------
@@ -168,6 +175,9 @@ def find_patches(network: CurveNetwork, *, close: str = "auto", tie_break: str =
     else:
         ps.report["manifold_defect"] = {"paper": _manifold_defect(network, ps.patches)}
         ps.report["order"] = "paper"
+    ps.report["holes"] = []
+    if holes:
+        ps.patches, ps.report["holes"] = hole_patches(network, ps.patches)
     ps.report["timings"] = {"patches": time.perf_counter() - t0}
     return ps
 

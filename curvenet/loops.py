@@ -17,7 +17,7 @@ from .errors import NetworkError
 from .network import CurveNetwork
 from .patchset import Patch
 
-__all__ = ["cycle_to_loop", "orient_patches", "loop_points", "newell_normal",
+__all__ = ["cycle_to_loop", "orient_patches", "orient_boundaries", "loop_points", "newell_normal",
            "signed_volume"]
 
 
@@ -137,7 +137,7 @@ def signed_volume(network, loops) -> float:
 
 
 def orient_patches(network: CurveNetwork, patches) -> list:
-    """Oriented loops of the patches, consistent across shared edges.
+    """Oriented outer loops of the patches, consistent across shared edges.
 
     Parameters
     ----------
@@ -147,30 +147,60 @@ def orient_patches(network: CurveNetwork, patches) -> list:
     Returns
     -------
     loops : list of list of (int, bool)
-        One loop per patch, same order.
+        One loop per patch (its outer boundary), same order; see
+        :func:`orient_boundaries` for the loops of patches with holes.
+    """
+    return [b[0] for b in orient_boundaries(network, patches)]
+
+
+def orient_boundaries(network: CurveNetwork, patches) -> list:
+    """Oriented boundary loops of the patches (outer first, then holes), consistent.
+
+    Parameters
+    ----------
+    network : CurveNetwork
+    patches : sequence of Patch or of edge-id sequences
+        A :class:`~curvenet.patchset.Patch` with ``holes`` is bounded by its
+        outer cycle and one cycle per hole.
+
+    Returns
+    -------
+    boundaries : list of list of list of (int, bool)
+        Per patch, its loops: ``[outer, hole_1, ...]``.
 
     Notes
     -----
     Patches are visited breadth-first across edges shared by exactly two
-    patches; a neighbour is reversed when it walks the shared edge in the same
-    direction, so adjacent patches traverse it in opposite directions where the
-    surface is orientable (non-manifold edges, used by three or more patches,
-    impose nothing; on a non-orientable surface the first orientation found
-    wins). Each group of patches connected this way that is closed (every edge
-    used twice within it) is then flipped as a whole if its fan-triangulated
-    signed volume is negative, so closed surfaces come out with outward normals
-    (right-hand rule); open ones keep the orientation of their first patch as
-    :func:`cycle_to_loop` walks it.
+    patches; a neighbour is reversed (all its loops) when it walks the shared
+    edge in the same direction, so adjacent patches traverse it in opposite
+    directions where the surface is orientable (non-manifold edges, used by
+    three or more patches, impose nothing; on a non-orientable surface the
+    first orientation found wins). Each group of patches connected this way
+    that is closed (every edge used twice within it) is then flipped as a
+    whole if its fan-triangulated signed volume is negative, so closed
+    surfaces come out with outward normals (right-hand rule); open ones keep
+    the orientation of their first patch as :func:`cycle_to_loop` walks it.
+    A hole is first walked against its outer loop (opposite Newell normals),
+    so the face lies on one side of all its loops.
     """
-    edge_sets = [p.edges if isinstance(p, Patch) else tuple(p) for p in patches]
-    loops = [cycle_to_loop(network, es) for es in edge_sets]
+    comps = [[p.edges, *p.holes] if isinstance(p, Patch) else [tuple(p)] for p in patches]
+    bounds = [[cycle_to_loop(network, es) for es in c] for c in comps]
+    for b in bounds:
+        n = newell_normal(network, b[0]) if len(b) > 1 else None
+        b[1:] = [[(x, not f) for x, f in reversed(lp)]
+                 if float(newell_normal(network, lp) @ n) > 0 else lp for lp in b[1:]]
+    edge_sets = [tuple(e for es in c for e in es) for c in comps]
     by_edge: dict = {}
     for i, es in enumerate(edge_sets):
         for e in es:
             by_edge.setdefault(int(e), []).append(i)
-    dirs = [{e: f for e, f in lp} for lp in loops]
-    done = [False] * len(loops)
-    for root in range(len(loops)):
+
+    def flipped(b):
+        return [[(x, not f) for x, f in reversed(lp)] for lp in b]
+
+    dirs = [{e: f for lp in b for e, f in lp} for b in bounds]
+    done = [False] * len(bounds)
+    for root in range(len(bounds)):
         if done[root]:
             continue
         done[root] = True
@@ -186,8 +216,8 @@ def orient_patches(network: CurveNetwork, patches) -> list:
                 if done[j]:
                     continue
                 if dirs[j][e] == dirs[i][e]:
-                    loops[j] = [(x, not f) for x, f in reversed(loops[j])]
-                    dirs[j] = {x: f for x, f in loops[j]}
+                    bounds[j] = flipped(bounds[j])
+                    dirs[j] = {x: f for lp in bounds[j] for x, f in lp}
                 done[j] = True
                 group.append(j)
                 q.append(j)
@@ -196,7 +226,7 @@ def orient_patches(network: CurveNetwork, patches) -> list:
             for e in edge_sets[i]:
                 uses[e] = uses.get(e, 0) + 1
         closed = all(n == 2 for n in uses.values())
-        if closed and signed_volume(network, [loops[i] for i in group]) < 0:
+        if closed and signed_volume(network, [lp for i in group for lp in bounds[i]]) < 0:
             for i in group:
-                loops[i] = [(x, not f) for x, f in reversed(loops[i])]
-    return loops
+                bounds[i] = flipped(bounds[i])
+    return bounds

@@ -6,7 +6,13 @@ without ``patches`` and with ``"format": "curvenet.network"``)::
     {"format": "curvenet.patches", "version": 1,
      "vertices": [[x, y, z], ...],
      "edges":    [{"u": 0, "v": 3, "curve": [[x, y, z], ...]}, ...],
-     "patches":  [{"edges": [0, 4, 7, 2], "source": "auto" | "closing" | "user"}, ...]}
+     "patches":  [{"edges": [0, 4, 7, 2], "source": "auto" | "closing" | "user",
+                   "holes": [[9, 10, 11], ...]}, ...]}
+
+``holes`` is optional (absent: a patch bounded by one loop): the edge cycles of
+the inner boundary loops of a face with holes, ``edges`` being its outer loop;
+in the cycle space the face is the sum of all of them. Readers that ignore
+``holes`` see the outer loop as a filled patch.
 """
 
 from __future__ import annotations
@@ -27,13 +33,30 @@ PATCH_SOURCES = ("auto", "closing", "user")
 
 @dataclass
 class Patch:
-    """One patch: a cycle given as a sorted tuple of edge ids."""
+    """One patch: a cycle given as a sorted tuple of edge ids, with optional holes.
+
+    ``holes`` holds one sorted tuple of edge ids per inner boundary loop (empty
+    for a disc); ``edges`` is the outer loop.
+    """
 
     edges: tuple
     source: str = "auto"
+    holes: tuple = ()
 
     def __post_init__(self):
         self.edges = tuple(sorted(int(e) for e in self.edges))
+        self.holes = tuple(tuple(sorted(int(e) for e in h)) for h in self.holes)
+
+    @property
+    def all_edges(self) -> tuple:
+        """Every boundary edge id, outer loop and holes (sorted)."""
+        return tuple(sorted(self.edges + tuple(e for h in self.holes for e in h)))
+
+    def to_dict(self) -> dict:
+        d = {"edges": list(self.edges), "source": self.source}
+        if self.holes:
+            d["holes"] = [list(h) for h in self.holes]
+        return d
 
 
 @dataclass
@@ -61,7 +84,7 @@ class PatchSet:
     def to_dict(self) -> dict:
         d = self.network.to_dict()
         d["format"] = "curvenet.patches"
-        d["patches"] = [{"edges": list(p.edges), "source": p.source} for p in self.patches]
+        d["patches"] = [p.to_dict() for p in self.patches]
         return d
 
     @classmethod
@@ -72,16 +95,20 @@ class PatchSet:
             try:
                 edges = [int(e) for e in p["edges"]]
                 source = str(p.get("source", "user"))
+                holes = [[int(e) for e in h] for h in p.get("holes", [])]
             except (KeyError, TypeError, ValueError):
                 raise SketchFormatError(f"patches[{i}]: expected {{'edges': [...]}}",
                                         path=path) from None
-            bad = [e for e in edges if not 0 <= e < net.number_of_edges]
+            every = edges + [e for h in holes for e in h]
+            bad = [e for e in every if not 0 <= e < net.number_of_edges]
+            if not all(holes):
+                raise SketchFormatError(f"patches[{i}]: empty hole", path=path)
             if bad or not edges:
                 raise SketchFormatError(f"patches[{i}]: edge ids {bad or edges} out of range "
                                         f"0..{net.number_of_edges - 1}", path=path)
             if source not in PATCH_SOURCES:
                 raise SketchFormatError(f"patches[{i}]: unknown source {source!r}", path=path)
-            patches.append(Patch(tuple(edges), source))
+            patches.append(Patch(tuple(edges), source, tuple(map(tuple, holes))))
         return cls(net, patches)
 
 

@@ -30,6 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import _cadnet
 from .core.geometry import cumulative_length, interpolate_polyline
 from .cycles import orient_patches
 from .network import CurveNetwork
@@ -39,6 +40,7 @@ __all__ = [
     "AnalyticShape", "box", "grid_box", "l_prism", "house", "two_boxes", "latlong_sphere",
     "ellipsoid", "capped_cylinder", "torus", "saddle_grid", "grid_sheet", "SHAPES",
     "sample_curves",
+    "washer", "holed_plate", "hex_nut", "flange", "boss_box", "l_bracket", "CAD_SHAPES",
 ]
 
 
@@ -58,6 +60,9 @@ class AnalyticShape:
         Genus of the true surface (closed shapes).
     reference : callable
         ``reference(subdivisions) -> trimesh.Trimesh``; use :meth:`reference_mesh`.
+    holes : list of list of list of (int, bool)
+        Per face, its inner boundary loops (empty for a disc); a hole is walked
+        against its face's outer loop. Empty list: no face has holes.
     """
 
     name: str
@@ -66,6 +71,12 @@ class AnalyticShape:
     closed: bool
     genus: int = 0
     reference: object = field(default=None, repr=False)
+    holes: list = field(default_factory=list)
+
+    def face_holes(self) -> list:
+        """Per face, its holes as sorted tuples of edge ids (``[]`` for a disc)."""
+        hs = self.holes or [[] for _ in self.faces]
+        return [sorted(tuple(sorted(e for e, _ in lp)) for lp in h) for h in hs]
 
     def reference_mesh(self, subdivisions: int = 5):
         """Dense triangle mesh of the true surface (``trimesh.Trimesh``).
@@ -399,6 +410,101 @@ def grid_sheet(n: int = 3, *, samples: int = 33) -> AnalyticShape:
     return _param_shape("grid_sheet", F, n, n, periodic_u=False, poles=False, samples=samples,
                         closed=False, genus=0, reference=lambda s: _grid_mesh(F, 4, 4))
 
+
+# --------------------------------------------------------------------------- CAD-like
+def _cad(name, builder, genus):
+    net, faces, holes, reference = builder.shape_parts()
+    return AnalyticShape(name, net, faces, True, genus, reference, holes)
+
+
+def _plate(b, outer, holes, thickness, frame=None):
+    """Prism of ``outer`` with through holes: two holed planar faces and their walls."""
+    frame = frame or _cadnet.Frame()
+    (bo, bop), (to, top) = b.wall(outer, frame, 0.0, thickness)
+    bottoms, tops = [(bo, bop)], [(to, top)]
+    for h in holes:
+        bh, th = b.wall(h, frame, 0.0, thickness)
+        bottoms.append(bh)
+        tops.append(th)
+    b.planar_face(bottoms)
+    b.planar_face(tops)
+
+
+def washer(outer: float = 1.0, inner: float = 0.5, thickness: float = 0.2, *,
+           samples: int = 33) -> AnalyticShape:
+    """Flat washer: two annular faces (one hole each), outer and bore walls of 4 quads; genus 1."""
+    b = _cadnet.CadBuilder(samples)
+    _plate(b, _cadnet.circle((0, 0), outer), [_cadnet.circle((0, 0), inner)], thickness)
+    return _cad("washer", b, 1)
+
+
+def holed_plate(*, samples: int = 33) -> AnalyticShape:
+    """3 x 2 x 0.2 plate with two round holes (r 0.3) and a 0.8 x 1 rectangular window; genus 3."""
+    b = _cadnet.CadBuilder(samples)
+    holes = [_cadnet.circle((0.7, 0.55), 0.3), _cadnet.circle((0.7, 1.45), 0.3),
+             _cadnet.polygon([(1.7, 0.5), (2.5, 0.5), (2.5, 1.5), (1.7, 1.5)])]
+    _plate(b, _cadnet.polygon([(0, 0), (3, 0), (3, 2), (0, 2)]), holes, 0.2)
+    return _cad("holed_plate", b, 3)
+
+
+def hex_nut(across_corners: float = 2.0, bore: float = 0.5, height: float = 0.8, *,
+            samples: int = 33) -> AnalyticShape:
+    """Hexagonal nut with a through bore whose wall has three seams (three quads); genus 1."""
+    b = _cadnet.CadBuilder(samples)
+    a = np.pi / 3 * np.arange(6)
+    hexagon = _cadnet.polygon(list(across_corners / 2 * np.c_[np.cos(a), np.sin(a)]))
+    _plate(b, hexagon, [_cadnet.circle((0, 0), bore, n_arcs=3, phase=np.pi / 2)], height)
+    return _cad("hex_nut", b, 1)
+
+
+def flange(radius: float = 1.5, bore: float = 0.5, bolts: int = 4, *,
+           samples: int = 33) -> AnalyticShape:
+    """Disc flange (thickness 0.3) with a bore and ``bolts`` bolt holes (r 0.15 at r 1.0)."""
+    b = _cadnet.CadBuilder(samples)
+    a = 2 * np.pi * (np.arange(bolts) + 0.5) / bolts
+    holes = [_cadnet.circle((0, 0), bore)] + [
+        _cadnet.circle((np.cos(t), np.sin(t)), 0.15, phase=t) for t in a]
+    _plate(b, _cadnet.circle((0, 0), radius), holes, 0.3)
+    return _cad("flange", b, 1 + bolts)
+
+
+def boss_box(*, samples: int = 33) -> AnalyticShape:
+    """2 x 2 x 1 box with a cylindrical boss (r 0.5, height 0.6) on top; the cap is a disc."""
+    b = _cadnet.CadBuilder(samples)
+    square = _cadnet.polygon([(0, 0), (2, 0), (2, 2), (0, 2)])
+    frame = _cadnet.Frame()
+    (bo, bop), (to, top) = b.wall(square, frame, 0.0, 1.0)
+    boss = _cadnet.circle((1, 1), 0.5)
+    (base, basep), cap = b.wall(boss, frame, 1.0, 1.6)
+    b.planar_face([(bo, bop)])
+    b.planar_face([(to, top), (base, basep)])
+    b.planar_face([cap])
+    return _cad("boss_box", b, 0)
+
+
+def l_bracket(*, samples: int = 33) -> AnalyticShape:
+    """L-bracket (legs 3 and 2 long, 0.3 thick, 2 wide) with a round hole (r 0.3) through
+    the upright leg; genus 1."""
+    b = _cadnet.CadBuilder(samples)
+    upright = _cadnet.Frame((0, 0, 0), (0, -1, 0), (0, 0, 1))  # the plane x = 0, normal -x
+    outer_rim, inner_rim = b.wall(_cadnet.circle((1.0, 1.2), 0.3), upright, 0.0, -0.3)
+    side = _cadnet.Frame((0, 0, 0), (1, 0, 0), (0, 0, 1))      # profile in xz, extruded along -y
+    ell = _cadnet.polygon([(0, 0), (3, 0), (3, 0.3), (0.3, 0.3), (0.3, 2), (0, 2)])
+    front, back = b.wall(ell, side, 0.0, 2.0, holes={5: [outer_rim], 3: [inner_rim]})
+    b.planar_face([front])
+    b.planar_face([back])
+    return _cad("l_bracket", b, 1)
+
+
+#: CAD-like solids whose faces have holes (not in :data:`SHAPES`, whose faces are discs).
+CAD_SHAPES = {
+    "washer": washer,
+    "holed_plate": holed_plate,
+    "hex_nut": hex_nut,
+    "flange": flange,
+    "boss_box": boss_box,
+    "l_bracket": l_bracket,
+}
 
 SHAPES = {
     "box": box,
