@@ -331,10 +331,11 @@ def _surface_route(plan: _Plan, decision: RouteDecision, settings: SurfaceSettin
     """Run the decided surfacer (and the refinement); returns ``(MeshResult, name)``."""
     res, name, init = None, None, None
     if _classical(plan, decision):
-        from .cycles import orient_patches
+        from .loops import orient_boundaries
         edges = net.edges
+        bounds = orient_boundaries(net, ps.patches)
         inp = SurfaceInput(settings, curves=[e.curve for e in edges],
-                           loops=orient_patches(net, ps.patches),
+                           loops=[b[0] for b in bounds], holes=[b[1:] for b in bounds],
                            crease_curves=[i for i, e in enumerate(edges) if e.label == "crease"])
         res = _run(plan.patch, inp, plan.options[plan.patch.name], timings, diag)
         name, init = plan.patch.label, (res.vertices, res.faces)

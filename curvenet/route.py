@@ -79,7 +79,7 @@ def coverage(ps: PatchSet) -> tuple[float, list]:
     lengths = np.array([e.length() for e in net.edges])
     used = np.zeros(len(lengths), bool)
     for p in ps.patches:
-        used[list(p.edges)] = True
+        used[list(p.all_edges)] = True
     total = lengths.sum()
     cov = float(lengths[used].sum() / total) if total > 0 else 0.0
     return cov, [int(i) for i in np.flatnonzero(~used)]

@@ -78,6 +78,9 @@ class SurfaceInput:
         Network curves (``needs="patches"``).
     loops : list of list of (int, bool)
         Oriented patch loops: (curve index, traversed forward) (``needs="patches"``).
+    holes : list of list of list of (int, bool)
+        Per loop, the loops of its holes (``[]`` for a disc; an empty list: no
+        patch has holes) (``needs="patches"``).
     crease_curves : list of int
         Curves labelled crease (``needs="patches"``).
     strokes : list of (n_i, 3) float64
@@ -91,6 +94,7 @@ class SurfaceInput:
     settings: SurfaceSettings = field(default_factory=SurfaceSettings)
     curves: list = field(default_factory=list)
     loops: list = field(default_factory=list)
+    holes: list = field(default_factory=list)
     crease_curves: list = field(default_factory=list)
     strokes: list = field(default_factory=list)
     labels: list = field(default_factory=list)
@@ -265,11 +269,17 @@ def _check_catmull_clark(options: dict, settings: SurfaceSettings) -> None:
     check_loops_options(**_loops_kwargs(options, settings))
 
 
+def _boundaries(inp: SurfaceInput) -> list:
+    """Per patch ``[outer loop, hole loops...]``."""
+    holes = inp.holes or [[] for _ in inp.loops]
+    return [[lp, *h] for lp, h in zip(inp.loops, holes)]
+
+
 def _catmull_clark(inp: SurfaceInput, options: dict) -> MeshResult:
-    from curvenet.surfacing import surface_loops
-    return surface_loops(inp.curves, inp.loops, crease_curves=inp.crease_curves,
-                         crease_angle=inp.settings.crease_angle,
-                         **_loops_kwargs(options, inp.settings))
+    from curvenet.surfacing.holes import surface_boundaries
+    return surface_boundaries(inp.curves, _boundaries(inp), crease_curves=inp.crease_curves,
+                              crease_angle=inp.settings.crease_angle,
+                              **_loops_kwargs(options, inp.settings))
 
 
 def _check_soapfilm(options: dict, settings: SurfaceSettings) -> None:
@@ -285,7 +295,9 @@ def _check_soapfilm(options: dict, settings: SurfaceSettings) -> None:
 
 def _soapfilm(inp: SurfaceInput, options: dict) -> MeshResult:
     from curvenet.surfacing import soapfilm_loops
-    return soapfilm_loops(inp.curves, inp.loops, **options)
+    from curvenet.surfacing.holes import split_boundaries
+    curves, loops, _ = split_boundaries(inp.curves, _boundaries(inp))
+    return soapfilm_loops(curves, loops, **options)
 
 
 def _check_neural(options: dict, settings: SurfaceSettings) -> None:

@@ -62,6 +62,8 @@ JUNCTION_TOL = 1e-6
 PIECE_LENGTH = 2.0
 #: ... and per this much total turning (degrees).
 PIECE_TURN = 120.0
+#: Ratios within this of an integer count as that integer (equal curves get equal pieces).
+PIECE_ROUNDING = 1e-9
 
 
 def curve_pieces(curves: list, closed: np.ndarray) -> np.ndarray:
@@ -82,8 +84,9 @@ def curve_pieces(curves: list, closed: np.ndarray) -> np.ndarray:
         d = np.diff(resample_polyline(c, 32), axis=0)
         d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), DIVISION_GUARD)
         turn[i] = np.degrees(np.arccos(np.clip((d[1:] * d[:-1]).sum(1), -1, 1))).sum()
-    m = np.maximum(np.ceil(lengths / (PIECE_LENGTH * max(med, DIVISION_GUARD))),
-                   np.ceil(turn / PIECE_TURN))
+    # a curve exactly PIECE_LENGTH medians long (rounding noise aside) stays one piece
+    m = np.maximum(np.ceil(lengths / (PIECE_LENGTH * max(med, DIVISION_GUARD)) - PIECE_ROUNDING),
+                   np.ceil(turn / PIECE_TURN - PIECE_ROUNDING))
     m = np.maximum(m, 1).astype(np.int64)
     return np.where(closed, np.maximum(m, 2), m)
 

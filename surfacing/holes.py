@@ -1,0 +1,333 @@
+"""Multiply-connected patches: planar faces with holes cut into simply-connected sectors.
+
+The classical route (Coons patches -> Catmull-Clark) surfaces loops bounding
+discs. A face bounded by an outer loop and hole loops is cut along straight
+segments joining junctions of different loops, taken shortest first, never
+crossing a boundary or each other, at most one per junction. When every loop
+hangs on at least two cuts and no cut alone holds a loop on (the cut graph is
+connected and bridgeless), every region between the cuts is a disc bounded by
+a simple loop. The
+regions are surfaced by :func:`surfacing.surface_loops` like any loop, and
+report as one patch (``face_patch``) with their face.
+
+Planar boundaries give planar surfaces: every patch whose boundary curves lie
+in a plane (within :data:`FLAT_TOL` of the diagonal) has its output vertices
+put in that plane (a vertex shared by several such patches on the intersection
+of their planes); a Coons patch of a planar boundary is planar already, so this
+removes only what the fairness across the boundary pulled out of the plane.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["split_holed", "split_boundaries", "flatten_planar", "surface_boundaries", "FLAT_TOL"]
+
+#: A patch is flat when its boundary points lie this close to a plane (fraction of the diagonal).
+FLAT_TOL = 1e-6
+
+
+def _start(curves, item):
+    c, f = item
+    return curves[c][0] if f else curves[c][-1]
+
+
+def _plane(points):
+    c = points.mean(axis=0)
+    _, _, vt = np.linalg.svd(points - c, full_matrices=False)
+    return c, vt[2], vt[:2]
+
+
+def _loop_points(curves, loop):
+    return np.concatenate([(curves[c] if f else curves[c][::-1])[:-1] for c, f in loop])
+
+
+def _cross2(a, b):
+    return a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+
+
+def _crosses(p, q, a, b, eps):
+    """Whether segment ``p q`` properly crosses any of the segments ``a[i] b[i]`` (2D)."""
+    d1, d2 = _cross2(q - p, a - p), _cross2(q - p, b - p)
+    d3, d4 = _cross2(b - a, p - a), _cross2(b - a, q - a)
+    return bool(np.any((d1 * d2 < -eps) & (d3 * d4 < -eps)))
+
+
+def _frame(curves, boundary):
+    pts = np.concatenate([_loop_points(curves, lp) for lp in boundary])
+    c, _, _ = _plane(pts)
+    outer = _loop_points(curves, boundary[0])
+    n = np.cross(outer, np.roll(outer, -1, axis=0)).sum(axis=0)
+    n /= np.linalg.norm(n)
+    e1 = np.linalg.svd(pts - c, full_matrices=False)[2][0]
+    e1 -= (e1 @ n) * n
+    e1 /= np.linalg.norm(e1)
+    return c, np.stack([e1, np.cross(n, e1)])
+
+
+def _choose_cuts(junctions, loop_of, segments, region, eps):
+    """Greedy shortest valid cuts between junctions of different loops (indices into junctions).
+
+    Every cut that crosses no boundary and no shorter cut and starts and ends
+    at junctions no other cut uses is taken (short cuts between all loops make
+    sectors close to convex); the face must come out cut into discs.
+    """
+    n_loops = int(loop_of.max()) + 1
+    i, j = np.triu_indices(len(junctions), 1)
+    keep = loop_of[i] != loop_of[j]
+    i, j = i[keep], j[keep]
+    order = np.argsort(np.linalg.norm(junctions[i] - junctions[j], axis=1), kind="stable")
+    used, cuts = set(), []
+    a, b = segments
+    for k in order:
+        p, q = junctions[i[k]], junctions[j[k]]
+        if i[k] in used or j[k] in used or not region.contains_point(0.5 * (p + q)):
+            continue
+        if _crosses(p, q, a, b, eps):
+            continue
+        if cuts and _crosses(p, q, junctions[[c[0] for c in cuts]],
+                             junctions[[c[1] for c in cuts]], eps):
+            continue
+        cuts.append((int(i[k]), int(j[k])))
+        used |= {i[k], j[k]}
+    if not _cut_graph_done([(loop_of[x], loop_of[y]) for x, y in cuts], n_loops):
+        raise ValueError("no set of straight cuts splits the face with holes into discs")
+    return cuts
+
+
+def _connected(pairs, n) -> bool:
+    """Whether the multigraph on ``n`` nodes with edges ``pairs`` is connected."""
+    import scipy.sparse as sp
+    from scipy.sparse.csgraph import connected_components
+    pr = np.asarray(pairs, dtype=np.int64).reshape(-1, 2)
+    g = sp.coo_matrix((np.ones(len(pr)), (pr[:, 0], pr[:, 1])), shape=(n, n))
+    return connected_components(g, directed=False)[0] == 1
+
+
+def _cut_graph_done(pairs, n_loops) -> bool:
+    """Connected, every loop on two cuts, and no cut a bridge."""
+    deg = np.bincount(np.asarray(pairs).ravel(), minlength=n_loops)
+    if (deg < 2).any() or not _connected(pairs, n_loops):
+        return False
+    return all(_connected(pairs[:k] + pairs[k + 1:], n_loops) for k in range(len(pairs)))
+
+
+def split_holed(curves, boundary, first_new: int, samples: int = 17):
+    """Cut one planar face with holes into simple loops.
+
+    Parameters
+    ----------
+    curves : list of (m_i, 3) float64
+    boundary : list of list of (int, bool)
+        ``[outer, hole_1, ...]`` loops of (curve index, forward).
+    first_new : int
+        Curve index the first cut gets.
+    samples : int
+        Points per cut polyline.
+
+    Returns
+    -------
+    loops : list of list of (int, bool)
+        The sectors, walked like the outer loop.
+    cuts : list of (samples, 3) float64
+        Straight cut polylines, curve indices ``first_new, first_new + 1, ...``.
+
+    Raises
+    ------
+    ValueError
+        No valid set of straight cuts (a face too winding for straight cuts).
+    """
+    from matplotlib.path import Path
+    c, axes = _frame(curves, boundary)
+    items = [it for lp in boundary for it in lp]
+    loop_of = np.concatenate([np.full(len(lp), k) for k, lp in enumerate(boundary)])
+    j3 = np.array([_start(curves, it) for it in items])
+    j2 = (j3 - c) @ axes.T
+    polys = [(_loop_points(curves, lp) - c) @ axes.T for lp in boundary]
+    seg_a = np.concatenate(polys)
+    seg_b = np.concatenate([np.roll(p, -1, axis=0) for p in polys])
+    scale = float(np.ptp(seg_a, axis=0).max())
+    region = Path(np.concatenate([np.vstack([p, p[:1]]) for p in polys]),
+                      np.concatenate([[Path.MOVETO] + [Path.LINETO] * (len(p) - 1)
+                                      + [Path.CLOSEPOLY] for p in polys]))
+    cuts = _choose_cuts(j2, loop_of, (seg_a, seg_b), region, 1e-12 * scale * scale)
+    t = np.linspace(0.0, 1.0, samples)[:, None]
+    cut_curves = [(1 - t) * j3[a] + t * j3[b] for a, b in cuts]
+    return _trace(curves, boundary, j2, axes, cuts, first_new), cut_curves
+
+
+def _trace(curves, boundary, j2, axes, cuts, first_new):
+    """Faces of the planar graph (loop curves + cuts) that contain a cut, walked CCW.
+
+    Junction ``k`` is the start of the ``k``-th loop item (loops concatenated).
+    """
+    half = []   # (origin junction, target junction, (curve, forward), polyline from origin)
+    base = 0
+    for lp in boundary:
+        for k, (ci, f) in enumerate(lp):
+            a, b = base + k, base + (k + 1) % len(lp)
+            pts = curves[ci] if f else curves[ci][::-1]
+            half += [(a, b, (ci, f), pts), (b, a, (ci, not f), pts[::-1])]
+        base += len(lp)
+    for m, (a, b) in enumerate(cuts):
+        half += [(a, b, (first_new + m, True), None), (b, a, (first_new + m, False), None)]
+    twin = np.arange(len(half)) ^ 1
+    for h, (a, b, item, pts) in enumerate(half):
+        d = (j2[b] - j2[a]) if pts is None else (pts[min(3, len(pts) - 1)] - pts[0]) @ axes.T
+        half[h] = (a, b, item, d)
+    out: dict = {}
+    for h, (a, _, _, _) in enumerate(half):
+        out.setdefault(a, []).append(h)
+    return _faces(half, twin, out, len(cuts), j2)
+
+
+def _faces(half, twin, out, n_cuts, j2):
+    """Walk the CCW faces; keep those through a cut with positive area."""
+    first_cut = len(half) - 2 * n_cuts
+    nxt = np.empty(len(half), dtype=np.int64)
+    for hs in out.values():
+        hs.sort(key=lambda h: np.arctan2(half[h][3][1], half[h][3][0]))
+    for h, (_, b, _, _) in enumerate(half):
+        ring = out[b]
+        nxt[h] = ring[(ring.index(int(twin[h])) - 1) % len(ring)]
+    seen = np.zeros(len(half), bool)
+    loops = []
+    for h0 in range(len(half)):
+        if seen[h0]:
+            continue
+        walk, h = [], h0
+        while not seen[h]:
+            seen[h] = True
+            walk.append(h)
+            h = int(nxt[h])
+        p = j2[[half[h][0] for h in walk]]
+        area = _cross2(p, np.roll(p, -1, axis=0)).sum()
+        if max(walk) >= first_cut and area > 0:
+            loops.append([half[h][2] for h in walk])
+    return loops
+
+
+def split_boundaries(curves, boundaries, samples: int = 17):
+    """Split every multiply-connected patch into sectors (:func:`split_holed`).
+
+    Parameters
+    ----------
+    curves : list of (m_i, 3) float64
+    boundaries : list of list of list of (int, bool)
+        Per patch ``[outer, hole_1, ...]``; a patch with one loop is kept as is.
+
+    Returns
+    -------
+    curves : list of (m_i, 3) float64
+        The input curves followed by the cuts.
+    loops : list of list of (int, bool)
+        Simple loops to surface.
+    owner : (len(loops),) int64
+        Patch index of each loop.
+    """
+    curves = list(curves)
+    loops, owner = [], []
+    for pi, b in enumerate(boundaries):
+        subs = [b[0]]
+        if len(b) > 1:
+            subs, cuts = split_holed(curves, b, len(curves), samples)
+            curves += cuts
+        loops += subs
+        owner += [pi] * len(subs)
+    return curves, loops, np.asarray(owner, dtype=np.int64)
+
+
+def flatten_planar(vertices, faces, face_patch, curves, boundaries, tol: float = FLAT_TOL):
+    """Put the output vertices of every flat patch in its plane.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64
+    faces : (f, 3) int64
+    face_patch : (f,) int64
+        Patch of each face (index into ``boundaries``).
+    curves : list of (m_i, 3) float64
+    boundaries : list of list of list of (int, bool)
+    tol : float
+        Flatness of a boundary, fraction of the curves' bounding-box diagonal.
+
+    Returns
+    -------
+    vertices : (n, 3) float64
+        A copy; a vertex of several flat patches lands on the intersection of
+        their planes nearest to it (least squares).
+    flat : (len(boundaries),) bool
+        Which patches are flat.
+    """
+    allpts = np.concatenate([np.asarray(c, float) for c in curves])
+    diag = float(np.linalg.norm(np.ptp(allpts, axis=0))) or 1.0
+    normals = np.zeros((len(boundaries), 3))
+    offsets = np.zeros(len(boundaries))
+    flat = np.zeros(len(boundaries), bool)
+    for k, b in enumerate(boundaries):
+        pts = np.concatenate([_loop_points(curves, lp) for lp in b])
+        c, n, _ = _plane(pts)
+        flat[k] = np.abs((pts - c) @ n).max() <= tol * diag
+        normals[k], offsets[k] = n, n @ c
+    V = np.array(vertices, dtype=np.float64)
+    fp = np.asarray(face_patch)
+    sel = flat[fp]
+    if not sel.any():
+        return V, flat
+    import scipy.sparse as sp
+    f, p = np.asarray(faces)[sel], fp[sel]
+    inc = sp.csr_matrix((np.ones(f.size), (f.ravel(), np.repeat(p, 3))),
+                        shape=(len(V), len(boundaries)))
+    inc.data[:] = 1.0
+    inc.sum_duplicates()
+    inc.data[:] = 1.0
+    rows = np.flatnonzero(np.diff(inc.indptr))
+    counts = np.diff(inc.indptr)[rows]
+    K = int(counts.max())
+    N = np.zeros((len(rows), K, 3))
+    d = np.zeros((len(rows), K))
+    slot = np.arange(inc.nnz) - np.repeat(inc.indptr[rows], counts)
+    r = np.repeat(np.arange(len(rows)), counts)
+    N[r, slot], d[r, slot] = normals[inc.indices], offsets[inc.indices]
+    x = V[rows]
+    resid = np.einsum("mkj,mj->mk", N, x) - d
+    G = np.linalg.pinv(np.einsum("mkj,mlj->mkl", N, N))
+    V[rows] = x - np.einsum("mkj,mkl,ml->mj", N, G, resid)
+    return V, flat
+
+
+def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: float = FLAT_TOL,
+                       **options):
+    """:func:`surfacing.surface_loops` for patches that may have holes; flat patches flat.
+
+    Parameters
+    ----------
+    curves : list of (m_i, 3) float64
+    boundaries : list of list of list of (int, bool)
+        Per patch ``[outer, hole_1, ...]`` loops of (curve index, forward).
+    cut_samples : int
+        Points per cut polyline.
+    flat_tol : float
+        See :func:`flatten_planar`.
+    **options
+        Passed to :func:`surfacing.surface_loops` (``crease_curves``, ``resolution``, ...).
+
+    Returns
+    -------
+    PatchMeshResult
+        ``face_patch`` indexes ``boundaries``; ``report`` adds ``n_sectors``
+        (loops surfaced), ``cuts`` and ``flat_patches``; ``curves`` (when asked
+        for) holds the input curves only.
+    """
+    from .api import PatchMeshResult, surface_loops
+    n = len(curves)
+    all_curves, loops, owner = split_boundaries(curves, boundaries, cut_samples)
+    res = surface_loops(all_curves, loops, **options)
+    face_patch = owner[res.face_patch]
+    V, flat = flatten_planar(res.vertices, res.faces, face_patch, curves, boundaries, flat_tol)
+    report = dict(res.report, n_patches=len(boundaries), n_sectors=len(loops),
+                  cuts=len(all_curves) - n, flat_patches=int(flat.sum()))
+    new_curves = None if res.curves is None else res.curves[:n]
+    return PatchMeshResult(V, res.faces, report, face_patch=face_patch, curves=new_curves,
+                           control_vertices=res.control_vertices,
+                           control_quads=res.control_quads)

@@ -1,0 +1,174 @@
+"""Faces with holes: the CAD-like oracles, hole detection, multiply-connected surfacing."""
+
+import json
+
+import numpy as np
+import pytest
+import trimesh
+
+from curvenet import shapes
+from curvenet.cycles import find_patches
+from curvenet.holes import hole_patches
+from curvenet.loops import signed_volume
+from curvenet.patchset import Patch, PatchSet, load_network_file, save_patchset
+
+CAD = sorted(shapes.CAD_SHAPES)
+
+#: true area of each CAD shape's surface (closed form)
+AREAS = {
+    "washer": 2 * np.pi * (1 - 0.25) + 2 * np.pi * (1 + 0.5) * 0.2,
+    "holed_plate": 2 * (6 - 2 * np.pi * 0.09 - 0.8) + 10 * 0.2 + 2 * 2 * np.pi * 0.3 * 0.2
+    + 3.6 * 0.2,
+    "hex_nut": 2 * (1.5 * np.sqrt(3) - np.pi * 0.25) + 6 * 0.8 + 2 * np.pi * 0.5 * 0.8,
+    "flange": 2 * np.pi * (2.25 - 0.25 - 4 * 0.0225) + 2 * np.pi * (1.5 + 0.5 + 4 * 0.15) * 0.3,
+    "boss_box": 2 * 4 + 4 * 2 + 2 * np.pi * 0.5 * 0.6,
+    "l_bracket": 2 * 1.41 + 10 * 2 + 2 * np.pi * 0.3 * 0.3 - 2 * np.pi * 0.09,
+}
+
+
+@pytest.fixture(scope="module", params=CAD)
+def cad(request):
+    return shapes.CAD_SHAPES[request.param]()
+
+
+def _all_loops(s):
+    return s.faces + [lp for hs in s.holes for lp in hs]
+
+
+def test_cad_shape_is_consistent(cad):
+    net = cad.network
+    use = {}
+    for loop in _all_loops(cad):
+        ends = [(net.edges[e].u, net.edges[e].v)[:: 1 if f else -1] for e, f in loop]
+        assert all(b == c for (_, b), (c, _) in zip(ends, ends[1:] + ends[:1]))
+        for e, f in loop:
+            use.setdefault(e, []).append(f)
+    # a closed oriented surface: every curve walked twice, in opposite directions
+    assert all(len(v) == 2 and v[0] != v[1] for v in use.values())
+    assert len(use) == net.number_of_edges
+    n_holes = sum(len(h) for h in cad.holes)
+    chi = net.number_of_vertices - net.number_of_edges + len(cad.faces) - n_holes
+    assert chi == 2 - 2 * cad.genus
+    assert signed_volume(net, _all_loops(cad)) > 0
+    ref = cad.reference_mesh(3)
+    assert ref.area == pytest.approx(AREAS[cad.name], rel=2e-3)
+    pts = np.concatenate([e.curve for e in net.edges])
+    _, dist, _ = trimesh.proximity.closest_point(ref, pts[::3])
+    assert dist.max() < 1e-3 * np.linalg.norm(ref.extents)
+
+
+def test_cad_patches_are_exact(cad):
+    ps = find_patches(cad.network)
+    got = sorted((p.edges, tuple(sorted(p.holes))) for p in ps.patches)
+    want = sorted((tuple(sorted(e for e, _ in f)), tuple(h))
+                  for f, h in zip(cad.faces, cad.face_holes()))
+    assert got == want
+    # every hole loop's own disc was dropped: a wall continues through each of them
+    assert len(ps.report["holes"]) == sum(len(h) for h in cad.holes)
+    assert not any(h["disc_kept"] for h in ps.report["holes"])
+
+
+def test_boss_cap_stays_a_disc():
+    s = shapes.boss_box()
+    ps = find_patches(s.network)
+    cap = [p for p in ps.patches
+           if np.allclose(np.concatenate([s.network.edges[e].curve for e in p.edges])[:, 2], 1.6)]
+    assert len(cap) == 1 and cap[0].holes == ()
+
+
+def test_hole_detection_off_keeps_simple_cycles():
+    s = shapes.washer()
+    ps = find_patches(s.network, holes=False)
+    assert all(not p.holes for p in ps.patches) and ps.report["holes"] == []
+    assert len(ps.patches) == len(s.faces) + 2
+
+
+def test_a_disc_drawn_inside_a_face_is_kept():
+    """A circle inside a square with nothing attached: the square gets a hole, the disc stays."""
+    from curvenet.network import CurveNetwork
+    net = CurveNetwork(np.zeros((0, 3)))
+    sq = [net.add_vertex(p) for p in ([0, 0, 0], [2, 0, 0], [2, 2, 0], [0, 2, 0])]
+    t = np.linspace(0, 1, 17)[:, None]
+    outer = [net.add_edge(a, b, (1 - t) * net.positions[a] + t * net.positions[b])
+             for a, b in zip(sq, sq[1:] + sq[:1])]
+    c = [net.add_vertex(p) for p in ([1.5, 1, 0], [0.5, 1, 0])]
+    a = np.pi * t
+    arc = np.c_[1 + 0.5 * np.cos(a), 1 + 0.5 * np.sin(a), 0 * a]
+    lower = np.c_[1 - 0.5 * np.cos(a), 1 - 0.5 * np.sin(a), 0 * a]
+    inner = [net.add_edge(c[0], c[1], arc), net.add_edge(c[1], c[0], lower)]
+    patches, report = hole_patches(net, [Patch(outer), Patch(inner)])
+    assert [p.holes for p in patches] == [(tuple(inner),), ()]
+    assert report == [{"face": 0, "loop": inner, "disc_kept": True}]
+    # lifted out of the square's plane, the circle is no hole
+    for i in inner:
+        net.edges[i].curve = net.edges[i].curve + [0, 0, 0.1]
+    net.positions[c] += [0, 0, 0.1]
+    patches, report = hole_patches(net, [Patch(outer), Patch(inner)])
+    assert report == [] and all(not p.holes for p in patches)
+
+
+def test_patches_json_keeps_holes(tmp_path):
+    s = shapes.washer()
+    ps = find_patches(s.network)
+    save_patchset(tmp_path / "p.json", ps)
+    back = load_network_file(tmp_path / "p.json")
+    assert [(p.edges, p.holes) for p in back.patches] == [(p.edges, p.holes) for p in ps.patches]
+    data = json.loads((tmp_path / "p.json").read_text())
+    assert data["version"] == 1
+    assert sum("holes" in p for p in data["patches"]) == 2
+    # a file without the field reads as before
+    for p in data["patches"]:
+        p.pop("holes", None)
+    assert all(not p.holes for p in PatchSet.from_dict(data).patches)
+    data["patches"][0]["holes"] = [[]]
+    with pytest.raises(Exception, match="empty hole"):
+        PatchSet.from_dict(data)
+
+
+def _classical(s):
+    from curvenet.pipeline import surface
+    return surface(s.network)
+
+
+@pytest.mark.parametrize("name", ["washer", "hex_nut", "boss_box"])
+def test_cad_classical_fscore(name):
+    from curvenet.evaluate import evaluate_mesh
+    s = shapes.CAD_SHAPES[name]()
+    res = _classical(s)
+    assert evaluate_mesh(res.mesh, s.reference_mesh(4), n_samples=30_000)["fscore"] >= 0.99
+
+
+@pytest.mark.parametrize("name", CAD)
+def test_cad_flat_faces_are_flat(name):
+    """Every output vertex of a planar face lies in its plane to 1e-6 of the diagonal."""
+    from curvenet.loops import orient_boundaries
+    from curvenet.surfacing.holes import surface_boundaries
+    s = shapes.CAD_SHAPES[name]()
+    net = s.network
+    ps = find_patches(net)
+    curves = [e.curve for e in net.edges]
+    res = surface_boundaries(curves, orient_boundaries(net, ps.patches),
+                             crease_curves=[i for i, e in enumerate(net.edges)
+                                            if e.label == "crease"])
+    diag = net.diagonal
+    n_flat = 0
+    for k, p in enumerate(ps.patches):
+        pts = np.concatenate([net.edges[e].curve for e in p.all_edges])
+        c = pts.mean(axis=0)
+        normal = np.linalg.svd(pts - c)[2][2]
+        if np.abs((pts - c) @ normal).max() > 1e-9 * diag:
+            continue
+        n_flat += 1
+        v = res.vertices[np.unique(res.faces[res.face_patch == k])]
+        assert np.abs((v - c) @ normal).max() <= 1e-6 * diag
+    assert n_flat == res.report["flat_patches"] >= 2
+
+
+@pytest.mark.parametrize("name", ["washer", "hex_nut", "boss_box"])
+def test_cad_output_topology(name):
+    """Welded output: a closed surface (no boundary loop) of the true genus (chi = 2 - 2g)."""
+    s = shapes.CAD_SHAPES[name]()
+    m = _classical(s).mesh.copy()
+    m.merge_vertices()
+    assert m.euler_number == 2 - 2 * s.genus
+    assert len(trimesh.grouping.group_rows(m.edges_sorted, require_count=1)) == 0
