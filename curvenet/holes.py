@@ -56,7 +56,8 @@ def hole_patches(network: CurveNetwork, patches, *, plane_tol: float = PLANE_TOL
         Same order, each outer patch carrying its holes, dropped inner patches removed.
     report : list of dict
         One entry per hole: ``face`` (index in the returned list), ``loop`` (edge
-        ids), ``disc_kept`` (whether the loop's own patch stays as a disc).
+        ids), ``disc_kept`` (whether the loop's own patch stays as a disc),
+        ``source`` (that patch's source).
     """
     from matplotlib.path import Path
     tol = plane_tol * max(network.diagonal, 1e-300)
@@ -104,8 +105,8 @@ def hole_patches(network: CurveNetwork, patches, *, plane_tol: float = PLANE_TOL
         index[k] = len(out)
         hs = tuple(patches[i].edges for i in holes.get(k, ()))
         out.append(Patch(p.edges, p.source, hs) if hs else p)
-    report = [{"face": index[j], "loop": list(patches[i].edges), "disc_kept": i not in dropped}
-              for i, j in sorted(parent.items())]
+    report = [{"face": index[j], "loop": list(patches[i].edges), "disc_kept": i not in dropped,
+               "source": patches[i].source} for i, j in sorted(parent.items())]
     return out, report
 
 

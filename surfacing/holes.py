@@ -319,7 +319,8 @@ def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: f
         (loops surfaced), ``cuts`` and ``flat_patches``; ``curves`` (when asked
         for) holds the input curves only.
     """
-    from .api import PatchMeshResult, surface_loops
+    from . import surface_loops     # the package's, so a patched one is the one called
+    from .api import PatchMeshResult
     n = len(curves)
     all_curves, loops, owner = split_boundaries(curves, boundaries, cut_samples)
     res = surface_loops(all_curves, loops, **options)

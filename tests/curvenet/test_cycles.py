@@ -148,7 +148,9 @@ def test_runs_on_public_networks(data_dir):
         ps = find_patches(net)
         assert ps.report["full_rank"], f
         auto = [p for p in ps.patches if p.source == "auto"]
-        assert len(auto) + len(ps.report["handle_cycles"]) == net.cycle_rank()
+        # a basis cycle that became a hole of the face around it, its disc dropped
+        absorbed = [h for h in ps.report["holes"] if not h["disc_kept"] and h["source"] == "auto"]
+        assert len(auto) + len(ps.report["handle_cycles"]) + len(absorbed) == net.cycle_rank()
         for p in ps.patches:
             cycle_to_loop(net, p.edges)
 

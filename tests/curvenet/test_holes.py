@@ -98,7 +98,7 @@ def test_a_disc_drawn_inside_a_face_is_kept():
     inner = [net.add_edge(c[0], c[1], arc), net.add_edge(c[1], c[0], lower)]
     patches, report = hole_patches(net, [Patch(outer), Patch(inner)])
     assert [p.holes for p in patches] == [(tuple(inner),), ()]
-    assert report == [{"face": 0, "loop": inner, "disc_kept": True}]
+    assert report == [{"face": 0, "loop": inner, "disc_kept": True, "source": "auto"}]
     # lifted out of the square's plane, the circle is no hole
     for i in inner:
         net.edges[i].curve = net.edges[i].curve + [0, 0, 0.1]
