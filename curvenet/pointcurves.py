@@ -27,8 +27,10 @@ Recovery (:func:`recover_curves`)
 4. Curves. The graph splits into chains between nodes of degree other than
    two; junction nodes joined by chains shorter than ``3 c`` merge into one
    junction, placed at the least-squares intersection of the incoming chain
-   directions; a chain closing on itself with no junction stays a closed
-   loop; sharp turns (over 45 degrees within ``3 c``) split a chain into two
+   directions; short chains that noise laid across curves converging at a
+   junction (a loop back to it, or a bridge closing a triangle of short
+   chains with it) are dropped; a chain closing on itself with no junction
+   stays a closed loop; sharp turns (over 45 degrees within ``3 c``) split a chain into two
    curves meeting at a degree-2 vertex.
 
 Every chain comes back as an ordered polyline whose ends are exactly the
@@ -46,6 +48,7 @@ from scipy import sparse
 from scipy.sparse import csgraph
 from scipy.spatial import cKDTree
 
+from ._pointjunctions import bridges, junction_point
 from .core.geometry import cumulative_length, interpolate_polyline
 from .core.tolerances import DIVISION_GUARD
 from .errors import InvalidParameterError, SketchFormatError
@@ -426,34 +429,6 @@ def _prune(x, e, c, forks=False):
     return e, pruned
 
 
-def _end_line(x, nodes, c):
-    """Mean and direction of a chain's nodes between ``c`` and ``6 c`` from its first node."""
-    p = x[nodes]
-    s = cumulative_length(p)
-    sel = p[(s >= c) & (s <= 6 * c)]
-    if len(sel) < 2:
-        return None
-    mu = sel.mean(axis=0)
-    d = np.linalg.svd(sel - mu)[2][0]
-    return mu, d
-
-
-def _junction_point(x, members, ends, c):
-    """Least-squares meeting point of the lines along the chains ending at a junction."""
-    centre = x[members].mean(axis=0)
-    a, rhs = np.zeros((3, 3)), np.zeros(3)
-    for nodes in ends:
-        line = _end_line(x, nodes, c)
-        if line is not None:
-            proj = np.eye(3) - np.outer(line[1], line[1])
-            a += proj
-            rhs += proj @ line[0]
-    if np.linalg.eigvalsh(a)[0] < 0.3:
-        return centre
-    p = np.linalg.solve(a, rhs)
-    return p if np.linalg.norm(p - centre) < 2 * c else centre
-
-
 def _assemble(x, e, c):
     """Chains of the thinned graph -> (polylines, closed flags, junction points)."""
     n = len(x)
@@ -465,6 +440,7 @@ def _assemble(x, e, c):
     pairs = np.array([[ch[0], ch[-1]] for ch, s in zip(chains, short) if s], np.int64)
     _, cluster = csgraph.connected_components(_sym(n, pairs.reshape(-1, 2),
                                                    np.ones(len(pairs))), directed=False)
+    short |= bridges(chains, lengths, cluster, hub & ~short, c)
     closed = [ch[0] == ch[-1] and deg[ch[0]] == 2 for ch in chains]
     # curves: [nodes, start vertex, end vertex]; vertex = cluster label (-1: closed loop)
     curves = [[ch, -1 if cl else cluster[ch[0]], -1 if cl else cluster[ch[-1]]]
@@ -547,7 +523,7 @@ def _polylines(x, curves, cluster, c):
         members = np.flatnonzero(cluster == v)
         ends = [cv[0] if k == 1 else cv[0][::-1] for cv in curves for k in (1, 2)
                 if cv[k] == v]
-        where[v] = _junction_point(x, members, ends, c)
+        where[v] = junction_point(x, members, ends, c)
     strokes, corners = [], 0
     for nodes, a, b in curves:
         p = x[nodes]
