@@ -2,7 +2,8 @@
 
 Helpers of :mod:`curvenet.pointcurves`. A junction is placed at the
 least-squares meeting point of the lines along the chain ends that reach it
-(:func:`junction_point`). Where curves converge at small angles, noise links
+(:func:`junction_point`), a quadratic's tangent where an end is curved
+(:func:`end_line`). Where curves converge at small angles, noise links
 them near their junction; :func:`bridges` finds the short chains so made.
 """
 
@@ -11,15 +12,24 @@ from __future__ import annotations
 import numpy as np
 
 from .core.geometry import cumulative_length
+from .core.tolerances import DIVISION_GUARD
 
-_END_FROM, _END_TO = 1.0, 6.0   # a chain end spans these many cells from its junction
+_END_FROM, _END_TO = 2.0, 10.0  # a chain end spans these many cells from its junction
+_CURVED = 3.0                   # line over quadratic residual (RMS) of a curved end
 _WELL_POSED = 0.3               # smallest eigenvalue of the normal matrix to trust the fit
 _MAX_SHIFT = 2.0                # a fitted point this many cells off the junction nodes: refused
 _BRIDGE = 12.0                  # longest chain (cells) that noise can lay near a junction
 
 
 def end_line(x, nodes, c):
-    """Mean and direction of a chain's nodes between ``c`` and ``6 c`` from its first node.
+    """Point and direction at the start of a chain, from its nodes ``2 c`` to ``10 c`` along.
+
+    The nodes nearest the junction are left out: their projection onto the
+    local line mixes in the other chains there. A straight line through the
+    rest is used unless a quadratic in arc length fits them with a residual
+    :data:`_CURVED` times smaller (the end is curved); then the quadratic's
+    value and tangent at the chain's start, where a line fitted to a curved
+    end would miss the junction towards the inside of the bend.
 
     Parameters
     ----------
@@ -37,12 +47,21 @@ def end_line(x, nodes, c):
     """
     p = x[nodes]
     s = cumulative_length(p)
-    sel = p[(s >= _END_FROM * c) & (s <= _END_TO * c)]
+    m = (s >= _END_FROM * c) & (s <= _END_TO * c)
+    sel, t = p[m], s[m]
     if len(sel) < 2:
         return None
     mu = sel.mean(axis=0)
     d = np.linalg.svd(sel - mu)[2][0]
-    return mu, d
+    if len(sel) < 5:
+        return mu, d
+    line = np.linalg.norm((sel - mu) - np.outer((sel - mu) @ d, d), axis=1)
+    basis = np.vander(t, 3, increasing=True)
+    coef = np.linalg.lstsq(basis, sel, rcond=None)[0]
+    quad = np.linalg.norm(basis @ coef - sel, axis=1)
+    if (line ** 2).sum() < _CURVED ** 2 * (quad ** 2).sum():
+        return mu, d
+    return coef[0], coef[1] / max(float(np.linalg.norm(coef[1])), DIVISION_GUARD)
 
 
 def junction_point(x, members, ends, c):

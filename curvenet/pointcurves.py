@@ -27,7 +27,8 @@ Recovery (:func:`recover_curves`)
 4. Curves. The graph splits into chains between nodes of degree other than
    two; junction nodes joined by chains shorter than ``3 c`` merge into one
    junction, placed at the least-squares intersection of the incoming chain
-   directions; short chains that noise laid across curves converging at a
+   ends' tangent lines (fitted from ``2 c`` to ``10 c`` out; quadratic where
+   an end is curved); short chains that noise laid across curves converging at a
    junction (a loop back to it, or a bridge closing a triangle of short
    chains with it) are dropped; a chain closing on itself with no junction
    stays a closed loop; sharp turns (over 45 degrees within ``3 c``) split a chain into two

@@ -111,7 +111,7 @@ def test_short_triangle_bridge_dropped_long_one_kept():
 
 
 @pytest.mark.parametrize("name, case", [("box", "noisy"), ("torus", "uneven"),
-                                        ("sphere", "uneven")])
+                                        ("torus", "noisy"), ("sphere", "uneven")])
 def test_surface_from_points_scores_as_the_true_curves(name, case):
     # within 1 F-score point of the classical surface of the true curves
     shape = shapes.SHAPES[name]()
