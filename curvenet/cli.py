@@ -247,7 +247,9 @@ def _surface_one(inp: str, out: str, args) -> dict:
                 "faces": len(res.mesh.faces), "seconds": time.perf_counter() - t0,
                 "why": res.decision.explain(), "interrupted": res.interrupted,
                 "reading": res.diagnostics.get("reading", ""),
-                "snap": res.diagnostics.get("snap", {}).get("summary", "")}
+                "snap": res.diagnostics.get("snap", {}).get("summary", ""),
+                "regions": res.decision.explain_regions(),
+                "fidelity": res.diagnostics.get("fidelity")}
     except CurvenetError as err:
         return {"input": inp, "output": out, "status": "error", "error": _naming(err, inp),
                 "seconds": time.perf_counter() - t0}
@@ -283,6 +285,11 @@ def _cmd_surface(args) -> int:
         if row["snap"]:
             print(row["snap"])
         print(f"route: {row['why']}")
+        for line in row.get("regions", []):
+            print(f"  region {line}")
+        if row.get("fidelity"):
+            from .evaluate import format_fidelity
+            print(format_fidelity(row["fidelity"]))
     return 130 if row["interrupted"] else 0
 
 
@@ -405,8 +412,15 @@ def _cmd_eval(args) -> int:
         metrics = evaluate_mesh(args.mesh, args.reference, n_samples=args.samples,
                                 threshold=args.threshold, seed=args.seed)
     else:
+        from .evaluate import sketch_fidelity
         from .io import read_sketch
-        metrics = stroke_distance(args.mesh, read_sketch(ref))
+        from .routed import read_obj_wires
+        sketch = read_sketch(ref)
+        metrics = stroke_distance(args.mesh, sketch)
+        wires = read_obj_wires(args.mesh) if str(args.mesh).lower().endswith(".obj") else []
+        fid = sketch_fidelity(args.mesh, sketch, wires=wires)
+        metrics.update({f"fidelity_{k}": fid[k] for k in ("surface", "with_wires", "wire_share",
+                                                          "median", "p95")})
     for warning in metrics.get("warnings", []):
         print(f"curvenet eval: warning: {warning}", file=sys.stderr)
     print(json.dumps(metrics, indent=2) if args.json else format_report(metrics))

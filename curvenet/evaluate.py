@@ -24,7 +24,8 @@ from .core.geometry import as_polyline, densify_polyline, face_normals_areas, sa
 from .core.tolerances import DEGENERATE_AREA_REL, DIVISION_GUARD
 from .errors import InvalidParameterError, SketchFormatError
 
-__all__ = ["evaluate_mesh", "stroke_distance", "stroke_fidelity", "format_report",
+__all__ = ["evaluate_mesh", "stroke_distance", "stroke_fidelity", "sketch_fidelity",
+           "format_report",
            "load_mesh_arrays", "sample_surface", "point_surface_distance"]
 
 #: Stroke polylines are resampled with this spacing relative to the sketch's bbox diagonal.
@@ -357,7 +358,7 @@ def stroke_distance(mesh, strokes, *, spacing: float = STROKE_SPACING_REL) -> di
     >>> d["stroke_max"] < 1e-12
     True
     """
-    d, diag, _v = _stroke_sample_distances(mesh, strokes, spacing)
+    d, diag, _v, _pts = _stroke_sample_distances(mesh, strokes, spacing)
     d = d / diag
     return {
         "stroke_mean": float(d.mean()),
@@ -372,9 +373,9 @@ def stroke_distance(mesh, strokes, *, spacing: float = STROKE_SPACING_REL) -> di
 def _stroke_sample_distances(mesh, strokes, spacing):
     """Distances from arc-length stroke samples to the mesh (input units).
 
-    Returns ``(d, diag, vertices)``: ``d`` (k,) float64 per sample, ``diag`` the sketch's
-    bounding-box diagonal (samples are ``spacing * diag`` apart), ``vertices`` (V, 3)
-    float64 of the mesh.
+    Returns ``(d, diag, vertices, samples)``: ``d`` (k,) float64 per sample, ``diag`` the
+    sketch's bounding-box diagonal (samples are ``spacing * diag`` apart), ``vertices``
+    (V, 3) float64 of the mesh, ``samples`` (k, 3) float64 the stroke samples.
     """
     if not (isinstance(spacing, (int, float, np.floating)) and math.isfinite(spacing)
             and spacing > 0):
@@ -391,7 +392,7 @@ def _stroke_sample_distances(mesh, strokes, spacing):
         raise InvalidParameterError("mesh: all triangles have zero area")
     pts = np.concatenate([densify_polyline(pl, spacing * diag) for pl in lines])
     d, _ = point_surface_distance(pts, v, f)
-    return d, diag, v
+    return d, diag, v, pts
 
 
 def stroke_fidelity(mesh, strokes, *, tol: float = FIDELITY_TOL_REL,
@@ -426,11 +427,81 @@ def stroke_fidelity(mesh, strokes, *, tol: float = FIDELITY_TOL_REL,
     """
     if not (isinstance(tol, (int, float, np.floating)) and 0 < tol < 1):
         raise InvalidParameterError(f"tol must be a number in (0, 1), got {tol!r}")
-    d, _sketch_diag, v = _stroke_sample_distances(mesh, strokes, spacing)
+    d, _sketch_diag, v, _pts = _stroke_sample_distances(mesh, strokes, spacing)
     diag = float(np.linalg.norm(np.ptp(v, axis=0)))
     d = d / max(diag, DIVISION_GUARD)
     return {"fidelity": float(np.mean(d < tol)), "median": float(np.median(d)),
             "p95": float(np.percentile(d, 95)), "diagonal": diag}
+
+
+def sketch_fidelity(mesh, strokes, *, wires=(), tol: float = FIDELITY_TOL_REL,
+                    spacing: float = STROKE_SPACING_REL) -> dict:
+    """Stroke fidelity against the *sketch's* diagonal, of the surface and of surface + wires.
+
+    A stroke kept as a wire (a polyline written beside the mesh) counts as represented
+    where it lies within ``tol`` of a wire.
+
+    Parameters
+    ----------
+    mesh : trimesh.Trimesh, (vertices, faces) pair or path
+    strokes : Sketch, CurveNetwork, list of (n, 3) array_like, or path of a sketch file
+        As in :func:`stroke_distance`.
+    wires : list of (m, 3) array_like
+        Polylines of the output kept as wires (may be empty).
+    tol : float, default 0.01
+        Distance counted as "represented", relative to the sketch's bounding-box diagonal.
+    spacing : float, default 1e-3
+        Arc-length resampling step of strokes and wires, relative to the sketch's diagonal.
+
+    Returns
+    -------
+    dict
+        ``surface`` and ``with_wires`` (share of stroke length within ``tol`` of the
+        surface, of the surface or a wire), ``wire_share`` (share of stroke length that
+        only a wire represents), ``median`` and ``p95`` (stroke-to-surface distance /
+        the sketch's diagonal), ``median_with_wires`` and ``p95_with_wires`` (distance to
+        the nearer of surface and wires), ``diagonal`` (the sketch's, input units).
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> box = trimesh.creation.box()
+    >>> far = [[2.0, 0, 0], [3.0, 0, 0]]
+    >>> f = sketch_fidelity(box, [[[-0.5, -0.5, 0.5], [0.5, -0.5, 0.5]], far], wires=[far])
+    >>> round(f["surface"], 2), f["with_wires"], round(f["wire_share"], 2)
+    (0.5, 1.0, 0.5)
+    """
+    if not (isinstance(tol, (int, float, np.floating)) and 0 < tol < 1):
+        raise InvalidParameterError(f"tol must be a number in (0, 1), got {tol!r}")
+    d, diag, _v, pts = _stroke_sample_distances(mesh, strokes, spacing)
+    d = d / diag
+    both = d
+    lines = [as_polyline(w, name=f"wires[{i}]") for i, w in enumerate(wires)]
+    if lines:
+        from scipy.spatial import cKDTree
+        dense = np.concatenate([densify_polyline(pl, spacing * diag) for pl in lines])
+        both = np.minimum(d, cKDTree(dense).query(pts)[0] / diag)
+    return {"surface": float(np.mean(d < tol)), "with_wires": float(np.mean(both < tol)),
+            "wire_share": float(np.mean((both < tol) & ~(d < tol))),
+            "median": float(np.median(d)), "p95": float(np.percentile(d, 95)),
+            "median_with_wires": float(np.median(both)),
+            "p95_with_wires": float(np.percentile(both, 95)), "diagonal": diag, "tol": tol}
+
+
+def format_fidelity(fid: dict) -> str:
+    """One line of :func:`sketch_fidelity`'s figures, as ``--explain`` prints it.
+
+    Examples
+    --------
+    >>> print(format_fidelity({"surface": 0.9, "with_wires": 0.95, "wire_share": 0.05,
+    ...                        "median": 1e-3, "p95": 0.02}))  # doctest: +NORMALIZE_WHITESPACE
+    fidelity: 90% of stroke length within 1% of the diagonal
+    (95% with wires, 5% on wires only); median 0.10%, p95 2.00% of the diagonal
+    """
+    return (f"fidelity: {fid['surface']:.0%} of stroke length within "
+            f"{fid.get('tol', FIDELITY_TOL_REL):.0%} of the diagonal "
+            f"({fid['with_wires']:.0%} with wires, {fid['wire_share']:.0%} on wires only); "
+            f"median {fid['median']:.2%}, p95 {fid['p95']:.2%} of the diagonal")
 
 
 # ---------------------------------------------------------------------------
@@ -447,6 +518,11 @@ _ROWS = (  # key, label, format
     ("stroke_p95", "stroke distance p95", "{:.4e}"),
     ("stroke_max", "stroke distance max", "{:.4e}"),
     ("stroke_within_1pct", "strokes within 1%", "{:.2%}"),
+    ("fidelity_surface", "stroke length within 1% (surface)", "{:.2%}"),
+    ("fidelity_with_wires", "stroke length within 1% (surface+wires)", "{:.2%}"),
+    ("fidelity_wire_share", "stroke length on wires only", "{:.2%}"),
+    ("fidelity_median", "stroke distance median", "{:.4e}"),
+    ("fidelity_p95", "stroke-surface distance p95", "{:.4e}"),
     ("n_samples", "samples per mesh", "{:d}"),
     ("scale", "scale applied", "{:.6g}"),
 )

@@ -21,7 +21,7 @@ from .core.result import MeshResult
 from .errors import CurvenetError, InvalidParameterError, SketchFormatError
 from .network import CurveNetwork
 from .patchset import PatchSet, load_network_file
-from .route import AUTO_MIN_COVERAGE, RouteDecision, auto_route, coverage
+from .route import AUTO_MIN_COVERAGE, RouteDecision, coverage, region_route
 from .sketch import Sketch
 from .surfacers import (SurfaceInput, SurfaceSettings, Surfacer, get_surfacer,
                         surfacer_names)
@@ -60,6 +60,12 @@ class SurfaceResult:
         surfacer's report under its label.
     decision : RouteDecision or None
         The route decision as data (``dataclasses.asdict`` makes it JSON).
+    wires : list of (m, 3) float64
+        Curves that bound nothing, kept as polylines beside the mesh (``auto`` only).
+    face_route : (F,) uint8 or None
+        Per face, an index into ``routes``: the route that made it.
+    routes : tuple of str
+        Route names of ``face_route`` (``("classical", "neural")``).
     """
 
     mesh: object
@@ -70,6 +76,9 @@ class SurfaceResult:
     timings: dict = field(default_factory=dict)
     diagnostics: dict = field(default_factory=dict)
     decision: RouteDecision | None = None
+    wires: list = field(default_factory=list)
+    face_route: np.ndarray | None = None
+    routes: tuple = ()
 
     @property
     def interrupted(self) -> bool:
@@ -79,20 +88,33 @@ class SurfaceResult:
                     or neural.get("creases", {}).get("interrupted"))
 
     def save(self, path) -> Path:
-        """Write the mesh atomically; the format follows the extension."""
-        return write_mesh(path, self.mesh)
+        """Write the mesh atomically; the format follows the extension.
+
+        With wires or several routes, OBJ gets one group per route and the wires as
+        ``l`` records, PLY a ``route`` face property (:func:`curvenet.routed.write_routed`).
+        """
+        if not self.wires and len(self.routes) < 2:
+            return write_mesh(path, self.mesh)
+        from .routed import write_routed
+        _check_format(path)
+        return write_routed(path, self.mesh, self.face_route, self.routes, self.wires)
 
     def __repr__(self) -> str:
         return (f"<SurfaceResult(method={self.method!r}, "
                 f"vertices={len(self.mesh.vertices)}, faces={len(self.mesh.faces)})>")
 
 
-def write_mesh(path, mesh) -> Path:
-    """Write a ``trimesh.Trimesh`` to ``path`` (OBJ / PLY / STL / OFF / GLB) atomically."""
+def _check_format(path) -> Path:
     path = Path(path)
     if path.suffix.lower() not in MESH_FORMATS:
         raise InvalidParameterError(
             f"output {path}: unknown mesh format {path.suffix!r}; use one of {MESH_FORMATS}")
+    return path
+
+
+def write_mesh(path, mesh) -> Path:
+    """Write a ``trimesh.Trimesh`` to ``path`` (OBJ / PLY / STL / OFF / GLB) atomically."""
+    path = _check_format(path)
     with atomic_path(path) as tmp:
         mesh.export(tmp, file_type=path.suffix.lower()[1:])
     return path
@@ -295,19 +317,28 @@ def _find_patches(sketch, given, *, snap_tol, close, timings, diag):
     return net, ps
 
 
-def _decide(method: str, plan: _Plan, diag: dict) -> RouteDecision:
-    """The route: auto's rule, or what was requested (with the coverage when sought)."""
+def _decide(method: str, plan: _Plan, diag: dict, ps) -> RouteDecision:
+    """The route: auto's rule per region, or what was requested (with the coverage)."""
     if method == "auto":
-        return auto_route(diag["patches"], diag["coverage"], patch_surfacer=plan.patch.name,
-                          stroke_surfacer=plan.stroke.name)
+        from .hybrid import plan_regions
+        curves = [e.curve for e in ps.network.edges]
+        used = np.zeros(len(curves), bool)
+        used[sorted({i for p in ps.patches for i in p.edges})] = True
+        regions = plan_regions(curves, used) if ps.patches else []
+        covered = {"route": "classical", "curves": [int(i) for i in np.flatnonzero(used)],
+                   "length": float(sum(ps.network.edges[i].length()
+                                       for i in np.flatnonzero(used))),
+                   "patches": len(ps.patches)}
+        return region_route(diag["patches"], diag["coverage"], regions, covered,
+                            patch_surfacer=plan.patch.name, stroke_surfacer=plan.stroke.name)
     first = plan.patch or plan.stroke
     sought = {k: diag[k] for k in ("coverage", "patches") if k in diag}
     return RouteDecision(method, first.name, "requested", **sought)
 
 
 def _classical(plan: _Plan, decision: RouteDecision) -> bool:
-    """Whether the decision takes the route that needs patches."""
-    return plan.patch is not None and decision.surfacer == plan.patch.name
+    """Whether the decision takes the route that needs patches (alone or per region)."""
+    return plan.patch is not None and decision.surfacer.split("+")[0] == plan.patch.name
 
 
 def _strokes(sketch: Sketch | None, net: CurveNetwork | None):
@@ -418,7 +449,7 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
     if plan.patch is not None:
         net, ps = _find_patches(sketch, given, snap_tol=snap_tol, close=close, timings=timings,
                                 diag=diag)
-    decision = _decide(method, plan, diag)
+    decision = _decide(method, plan, diag, ps)
     diag["decision"] = decision.explain()
     if _classical(plan, decision) and not ps.patches:
         raise CurvenetError("no patches found: the curves form no cycles; try --method neural")
@@ -426,4 +457,18 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
                                timings=timings, diag=diag)
     if len(res.faces) == 0:
         raise CurvenetError(f"the {name} route produced an empty surface")
-    return SurfaceResult(res.to_trimesh(), name, sketch, net, ps, timings, diag, decision)
+    out = SurfaceResult(res.to_trimesh(), name, sketch, net, ps, timings, diag, decision)
+    if decision.regions:
+        from .hybrid import assemble
+        assemble(out, res, plan, settings, _run)
+    _fidelity(out)
+    return out
+
+
+def _fidelity(res: SurfaceResult) -> None:
+    """``diagnostics["fidelity"]``: :func:`curvenet.evaluate.sketch_fidelity` of the result."""
+    from .evaluate import sketch_fidelity
+    t = time.perf_counter()
+    ref = res.sketch if res.sketch is not None else res.network
+    res.diagnostics["fidelity"] = sketch_fidelity(res.mesh, ref, wires=res.wires)
+    res.timings["fidelity"] = time.perf_counter() - t

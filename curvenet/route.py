@@ -13,11 +13,16 @@ import numpy as np
 
 from .patchset import PatchSet
 
-__all__ = ["AUTO_MIN_COVERAGE", "RouteDecision", "REASONS", "coverage", "auto_route"]
+__all__ = ["AUTO_MIN_COVERAGE", "MAX_WIRE_SHARE", "RouteDecision", "REASONS", "coverage",
+           "auto_route", "region_route"]
 
 #: auto mode takes the classical route when at least this fraction of the
 #: network's curve length lies on curves used by some patch.
 AUTO_MIN_COVERAGE = 0.8
+
+#: the per-region route keeps the curves that bound nothing as wires only while they
+#: carry at most this fraction of the curve length (else auto's per-sketch rule holds)
+MAX_WIRE_SHARE = 0.5
 
 #: reason code -> sentence (``str.format`` over the decision's fields)
 REASONS = {
@@ -27,6 +32,10 @@ REASONS = {
                     "(< {min_coverage:.0%})",
     "covered": "{patches} patches cover {coverage:.0%} of the curve length "
                "(>= {min_coverage:.0%})",
+    "hybrid": "{patches} patches cover {coverage:.0%} of the curve length; the rest "
+              "is filled per region",
+    "unstructured": "patches cover only {coverage:.0%} of the curve length and most of "
+                    "the rest spans area: one neural surface",
 }
 
 
@@ -70,6 +79,13 @@ class RouteDecision:
         """``"<method>: <why>"``, the sentence ``--explain`` prints."""
         return f"{self.method}: " + REASONS[self.reason].format(**asdict(self))
 
+    def explain_regions(self) -> list:
+        """One line per region: ``"<route>: <n> curves, <share> of the curve length"``."""
+        total = sum(r["length"] for r in self.regions) or 1.0
+        return [f"{r['route']}: {len(r['curves'])} curves, {r['length'] / total:.0%} of the "
+                f"curve length" + (f" ({r['patches']} patches)" if "patches" in r else "")
+                for r in self.regions]
+
 
 def coverage(ps: PatchSet) -> tuple[float, list]:
     """Fraction of curve length on edges used by a patch, and the unused edge ids."""
@@ -101,3 +117,52 @@ def auto_route(n_patches: int, cov: float, *, patch_surfacer: str, stroke_surfac
     if cov < min_coverage:
         return RouteDecision("neural", stroke_surfacer, "low_coverage", **common)
     return RouteDecision("classical", patch_surfacer, "covered", **common)
+
+
+def region_route(n_patches: int, cov: float, regions: list, covered: dict, *,
+                 patch_surfacer: str, stroke_surfacer: str,
+                 min_coverage: float = AUTO_MIN_COVERAGE) -> RouteDecision:
+    """Auto's rule per region (:func:`curvenet.hybrid.plan_regions` made ``regions``).
+
+    Patches where cycles exist; the neural route alone when there are none, or when the
+    surface-like regions carry more curve length than the patches; auto's per-sketch
+    rule (:func:`auto_route`) when wires would carry more than :data:`MAX_WIRE_SHARE`
+    of it; else per region: patches, a neural fill for surface-like regions, wires.
+
+    Parameters
+    ----------
+    regions : list of dict
+        Regions of the curves no patch uses (``route``, ``curves``, ``length``).
+    covered : dict
+        The classical region: ``route="classical"``, ``curves``, ``length``, ``patches``.
+
+    Examples
+    --------
+    >>> wire = {"route": "wires", "curves": [7], "length": 1.0}
+    >>> patched = {"route": "classical", "curves": [0, 1, 2], "length": 3.0, "patches": 1}
+    >>> d = region_route(1, 0.75, [wire], patched, patch_surfacer="catmull-clark",
+    ...                  stroke_surfacer="neural")
+    >>> d.method
+    'classical'
+    >>> print(*d.explain_regions(), sep=chr(10))
+    classical: 3 curves, 75% of the curve length (1 patches)
+    wires: 1 curves, 25% of the curve length
+    """
+    base = auto_route(n_patches, cov, patch_surfacer=patch_surfacer,
+                      stroke_surfacer=stroke_surfacer, min_coverage=min_coverage)
+    if not n_patches or not regions:
+        return base
+    total = covered["length"] + sum(r["length"] for r in regions)
+    fill = sum(r["length"] for r in regions if r["route"] == "neural")
+    wires = sum(r["length"] for r in regions if r["route"] == "wires")
+    common = dict(coverage=cov, patches=n_patches, min_coverage=min_coverage,
+                  regions=[covered] + regions)
+    if fill > covered["length"]:
+        common["regions"] = []
+        return RouteDecision("neural", stroke_surfacer, "unstructured", **common)
+    if wires > MAX_WIRE_SHARE * total:
+        return base
+    if not fill:
+        reason = "covered" if cov >= min_coverage else "hybrid"
+        return RouteDecision("classical", patch_surfacer, reason, **common)
+    return RouteDecision("hybrid", f"{patch_surfacer}+{stroke_surfacer}", "hybrid", **common)

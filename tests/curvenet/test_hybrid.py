@@ -1,0 +1,120 @@
+"""The per-region route of auto: patches, a neural fill, wires; stroke fidelity."""
+
+import numpy as np
+import pytest
+
+import curvenet
+from curvenet import shapes
+from curvenet.cli import main
+from curvenet.evaluate import sketch_fidelity
+from curvenet.hybrid import plan_regions
+from curvenet.routed import read_obj_wires
+from curvenet.sketch import Sketch
+
+T = np.linspace(0, 1, 40)
+
+
+def _ribbon(z=1.3, n=6):
+    """Loose parallel strokes spanning a sheet above the unit box (they touch nothing)."""
+    return [np.c_[0.1 + 0.8 * T, 0 * T + y, z + 0.15 * np.sin(np.pi * T)]
+            for y in np.linspace(0.25, 0.75, n)]
+
+
+def _leg():
+    """One stroke hanging from a corner of the unit box: it bounds nothing."""
+    return np.c_[0 * T + 1.0, 0 * T + 1.0, -1.0 * T]
+
+
+def _flower():
+    """Closed petal and leaf loops on one long stem stroke."""
+    stem = np.c_[0 * T, 0 * T, 3.0 * T]
+    u = np.linspace(0, 2 * np.pi, 61)
+    loops = []
+    for k in range(4):   # petals: loops through the stem's top, in planes around it
+        d = np.array([np.cos(k * np.pi / 2), np.sin(k * np.pi / 2), 0.0])
+        r = 0.5 * (1 - np.cos(u))[:, None] * d + 0.3 * np.sin(u)[:, None] * np.array(
+            [0, 0, 1.0]) + np.cross([0, 0, 1.0], d) * 0.3 * np.sin(u)[:, None]
+        loops.append(np.array([0, 0, 3.0]) + r)
+    for k, z in ((0, 1.0), (2, 1.6)):   # leaves
+        d = np.array([np.cos(k * np.pi / 2), np.sin(k * np.pi / 2), 0.0])
+        r = 0.6 * (1 - np.cos(u))[:, None] * d + 0.15 * np.sin(u)[:, None] * np.array(
+            [0, 0, 1.0])
+        loops.append(np.array([0, 0, z]) + r)
+    return Sketch([stem] + loops, ["boundary"] * (1 + len(loops)))
+
+
+def test_regions_split_surface_like_strokes_from_single_curves():
+    curves = _ribbon() + [_leg()] + [np.c_[T + 3, 0 * T, 0 * T]]
+    regions = plan_regions(curves, np.zeros(len(curves), bool))
+    routes = sorted((r["route"], tuple(r["curves"])) for r in regions)
+    assert routes == [("neural", (0, 1, 2, 3, 4, 5)), ("wires", (6,)), ("wires", (7,))]
+
+
+def test_four_separate_legs_stay_wires():
+    legs = [np.c_[0 * T + x, 0 * T + y, -T] for x in (0, 1) for y in (0, 1)]
+    assert [r["route"] for r in plan_regions(legs, np.zeros(4, bool))] == ["wires"] * 4
+
+
+def test_fully_covered_sketch_is_todays_classical_output(tmp_path):
+    sk = shapes.box().sketch()
+    auto = curvenet.surface(sk)
+    classical = curvenet.surface(sk, method="classical")
+    assert auto.decision.regions == [] and auto.wires == []
+    auto.save(tmp_path / "a.obj")
+    classical.save(tmp_path / "c.obj")
+    assert (tmp_path / "a.obj").read_bytes() == (tmp_path / "c.obj").read_bytes()
+    assert auto.diagnostics["fidelity"]["surface"] == 1.0
+
+
+def test_flower_patches_petals_and_leaves_and_keeps_the_stem_as_a_wire(tmp_path):
+    res = curvenet.surface(_flower())
+    assert res.method == "classical"
+    assert [r["route"] for r in res.decision.regions] == ["classical", "wires"]
+    assert res.decision.regions[0]["patches"] == 6
+    stem_length = sum(np.linalg.norm(np.diff(w, axis=0), axis=1).sum() for w in res.wires)
+    assert stem_length == pytest.approx(3.0, rel=1e-6)
+    fid = res.diagnostics["fidelity"]
+    assert fid["with_wires"] > 0.99 and fid["surface"] < fid["with_wires"]
+    assert fid["wire_share"] == pytest.approx(fid["with_wires"] - fid["surface"])
+    out = tmp_path / "flower.obj"
+    res.save(out)
+    text = out.read_text()
+    assert "g classical" in text and "g neural" not in text
+    wires = read_obj_wires(out)
+    assert len(wires) == len(res.wires)
+    np.testing.assert_allclose(np.concatenate(wires), np.concatenate(res.wires), atol=1e-8)
+
+
+def test_eval_counts_wires_of_the_obj(tmp_path, capsys):
+    res = curvenet.surface(_flower())
+    res.save(tmp_path / "f.obj")
+    from curvenet.io import write_sketch
+    write_sketch(tmp_path / "f_sketch.obj", res.sketch)
+    assert main(["eval", str(tmp_path / "f.obj"), str(tmp_path / "f_sketch.obj"),
+                 "--json"]) == 0
+    import json
+    metrics = json.loads(capsys.readouterr().out)
+    fid = sketch_fidelity(res.mesh, res.sketch, wires=res.wires)
+    assert metrics["fidelity_with_wires"] == pytest.approx(fid["with_wires"], abs=1e-3)
+    assert metrics["fidelity_surface"] < metrics["fidelity_with_wires"]
+
+
+@pytest.mark.slow
+def test_box_with_a_loose_ribbon_gets_a_neural_fill_and_a_wire(tmp_path):
+    sk = shapes.box().sketch()
+    sketch = Sketch(sk.strokes + _ribbon() + [_leg()], list(sk.labels) + ["boundary"] * 7)
+    res = curvenet.surface(sketch)
+    assert res.method == "hybrid"
+    assert [r["route"] for r in res.decision.regions] == ["classical", "neural", "wires"]
+    assert res.routes == ("classical", "neural")
+    counts = np.bincount(res.face_route)
+    assert counts[0] == len(curvenet.surface(sk).mesh.faces) and counts[1] > 0
+    neural = res.mesh.triangles_center[res.face_route == 1]
+    assert neural[:, 2].min() > 1.0 + 0.01          # the fill lies above the box's top
+    fid = res.diagnostics["fidelity"]
+    assert fid["with_wires"] >= 0.85 and fid["wire_share"] < 0.5
+    res.save(tmp_path / "h.ply")
+    import trimesh
+    ply = trimesh.load(tmp_path / "h.ply", process=False)
+    raw = ply.metadata["_ply_raw"]["face"]["data"]["route"]
+    np.testing.assert_array_equal(raw, res.face_route)
