@@ -15,6 +15,7 @@ import numpy as np
 from curvenet.core.result import MeshResult
 from curvenet.errors import InvalidParameterError
 
+from .bspline import ControlNet
 from .catmull_clark import edge_index, subdivision_step
 from .controlmesh import build_control_mesh
 from .creases import DEFAULT_CREASE_ANGLE, sharp_structure
@@ -60,12 +61,17 @@ class PatchMeshResult(MeshResult):
         Updated network curves when ``update_curves`` was asked for.
     control_vertices, control_quads : arrays or None
         The fitted control mesh (classical route only).
+    control_net : surfacing.bspline.ControlNet or None
+        The fitted control mesh with its patches, creases and curves, for B-spline
+        export (classical route only).
     """
 
     face_patch: np.ndarray
     curves: list | None = None
     control_vertices: np.ndarray | None = None
     control_quads: np.ndarray | None = None
+    control_net: ControlNet | None = None
+    control_net: ControlNet | None = None
 
 
 def _quads_to_tris(q: np.ndarray) -> np.ndarray:
@@ -208,8 +214,9 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
     report = _report(cm, fit=fit, dev=dev, sample_dev=sample_dev, iters=iters, timings=timings,
                      crease=crease, detected=detected, n_faces=len(faces),
                      resolution=resolution, subdiv=int(subdiv))
+    net = ControlNet(P, cm.quads, cm.face_patch, *sharp, list(cm.curve_vids), cm.diagonal)
     return PatchMeshResult(V, faces, report, face_patch=face_patch, curves=new_curves,
-                           control_vertices=P, control_quads=cm.quads)
+                           control_vertices=P, control_quads=cm.quads, control_net=net)
 
 
 def _build(curves, loops, resolution, crease_curves, crease_angle, straight_angle):

@@ -1,0 +1,577 @@
+"""Catmull-Clark limit surface as bicubic B-spline patches, one per quad-grid piece.
+
+Each loop's control quads form one ``p x q`` grid (four-sided loops) or ``T`` grids
+around a centre (split loops); these are the *pieces*. After ``level`` subdivision
+steps a piece is an ``M x N`` grid (``M = 2^level p``). Where every vertex of a face
+is regular (valence four, or a crease/boundary vertex with two faces on each side,
+or a corner with one) the limit surface over that face is exactly the uniform
+bicubic B-spline of its 4 x 4 neighbourhood (Catmull & Clark 1978; across sharp
+edges the phantom row ``2 P_0 - P_1`` reproduces the crease rules, DeRose et al.
+1998). So each piece is one B-spline surface with ``(M + 3) x (N + 3)`` poles: the
+piece's own control points plus the ring of vertices just outside it.
+
+Near irregular vertices (extraordinary valence, darts, T-junctions) the limit
+surface is not polynomial. There the poles whose support lies inside the
+irregular spans are fitted by least squares to exact limit points (limit
+positions of a finer level), and the remaining deviation is measured, not
+assumed. Everything else is exact to rounding.
+
+Arrays in, arrays out: this module knows no graph and no CAD kernel.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.interpolate import BSpline
+
+from .catmull_clark import _sharp_mask, edge_index, edge_topology, subdivision_step
+from .limit import limit_matrix
+
+__all__ = ["ControlNet", "BSplinePiece", "BSplineSet", "piece_grids", "refine_grid",
+           "extract_bsplines", "uniform_knots", "clamp_uniform", "evaluate",
+           "DEFAULT_LEVEL", "EXACT_TOL"]
+
+#: Subdivision steps before the pieces are read off as B-splines.
+DEFAULT_LEVEL = 2
+#: Spans whose limit samples deviate more than this fraction of the diagonal from the
+#: uniform B-spline are irregular (exact spans agree to rounding, about 1e-15).
+EXACT_TOL = 1e-10
+
+
+@dataclass
+class ControlNet:
+    """The fitted level-0 control mesh with everything subdivision needs.
+
+    Attributes
+    ----------
+    vertices : (n, 3) float64
+    quads : (f, 4) int64
+        Consistently oriented; each patch's quads in the row-major order of its grids
+        (see :func:`piece_grids`).
+    face_patch : (f,) int64
+    sharp_edges : (s, 2) int64
+    corners : (n,) bool
+    curve_vids : list of (k + 1,) int64
+        Control vertices along each network curve.
+    diagonal : float
+    """
+
+    vertices: np.ndarray
+    quads: np.ndarray
+    face_patch: np.ndarray
+    sharp_edges: np.ndarray
+    corners: np.ndarray
+    curve_vids: list = field(default_factory=list)
+    diagonal: float = 1.0
+
+
+@dataclass
+class BSplinePiece:
+    """One clamped bicubic B-spline surface.
+
+    Attributes
+    ----------
+    poles : (a, b, 3) float64
+    knots_u : (a + 4,) float64, knots_v : (b + 4,) float64
+        Clamped knot vectors (end knots repeated four times), parameters in spans of
+        the subdivided grid: ``u`` in ``[0, M]``, ``v`` in ``[0, N]``.
+    patch : int
+        Loop index.
+    exact : bool
+        True when no span needed fitting.
+    deviation : float
+        Largest distance to the exact limit samples, fraction of the diagonal.
+    """
+
+    poles: np.ndarray
+    knots_u: np.ndarray
+    knots_v: np.ndarray
+    patch: int
+    exact: bool
+    deviation: float
+
+
+@dataclass
+class BSplineSet:
+    """B-spline pieces of a control net and the continuity report.
+
+    Attributes
+    ----------
+    pieces : list of BSplinePiece
+    seams : list of dict
+        One per pair of pieces sharing a border: ``pieces``, ``patches``, ``curves``
+        (network curves along it), ``crease``, ``gap`` (G0, fraction of the
+        diagonal), ``angle`` (G1, degrees), ``deviation``.
+    report : dict
+        ``level``, ``n_pieces``, ``n_exact``, ``max_deviation``, ``pieces_per_patch``.
+    """
+
+    pieces: list
+    seams: list
+    report: dict
+
+
+def piece_grids(quads: np.ndarray, face_patch: np.ndarray) -> list:
+    """Recover the quad grids of every patch from the control mesh's face order.
+
+    A grid ``G (p + 1, q + 1)`` owns the quads
+    ``(G[i, j], G[i + 1, j], G[i + 1, j + 1], G[i, j + 1])`` in row-major order, the
+    order :mod:`.controlmesh` writes them in.
+
+    Returns
+    -------
+    list of (patch, G (p + 1, q + 1) int64)
+
+    Raises
+    ------
+    ValueError
+        If a patch's quads are not a sequence of such grids.
+    """
+    quads = np.asarray(quads, dtype=np.int64)
+    out = []
+    for j in np.unique(face_patch):
+        qs = quads[np.flatnonzero(face_patch == j)]
+        brk = np.flatnonzero(qs[1:, 0] != qs[:-1, 3]) + 1
+        rows = np.split(qs, brk)
+        grids: list = [[rows[0]]]
+        for r in rows[1:]:
+            prev = grids[-1][-1]
+            if len(r) == len(prev) and r[0, 0] == prev[0, 1]:
+                grids[-1].append(r)
+            else:
+                grids.append([r])
+        for g in grids:
+            R = np.stack(g)                                  # (p, q, 4)
+            p, q = R.shape[:2]
+            G = np.empty((p + 1, q + 1), dtype=np.int64)
+            G[:p, :q] = R[:, :, 0]
+            G[p, :q] = R[-1, :, 1]
+            G[:p, q] = R[:, -1, 3]
+            G[p, q] = R[-1, -1, 2]
+            if not np.array_equal(_grid_quads(G), R.reshape(-1, 4)):
+                raise ValueError(f"patch {j}: its quads are not row-major grids")
+            out.append((int(j), G))
+    return out
+
+
+def _grid_quads(G):
+    return np.stack([G[:-1, :-1].ravel(), G[1:, :-1].ravel(), G[1:, 1:].ravel(),
+                     G[:-1, 1:].ravel()], axis=1)
+
+
+def _diag_lookup(quads: np.ndarray, n: int):
+    """Face of a quad given one diagonal: ``find(a, c) -> face or -1``."""
+    k02 = np.minimum(quads[:, 0], quads[:, 2]) * n + np.maximum(quads[:, 0], quads[:, 2])
+    k13 = np.minimum(quads[:, 1], quads[:, 3]) * n + np.maximum(quads[:, 1], quads[:, 3])
+    keys = np.concatenate([k02, k13])
+    face = np.tile(np.arange(len(quads)), 2)
+    order = np.argsort(keys)
+    keys, face = keys[order], face[order]
+
+    def find(a, c):
+        k = np.minimum(a, c) * n + np.maximum(a, c)
+        pos = np.clip(np.searchsorted(keys, k), 0, len(keys) - 1)
+        return np.where(keys[pos] == k, face[pos], -1)
+    return find
+
+
+def refine_grid(G: np.ndarray, quads: np.ndarray, topo, find=None) -> np.ndarray:
+    """The grid ``G`` one Catmull-Clark step later (see :mod:`.catmull_clark` order).
+
+    Parameters
+    ----------
+    G : (p + 1, q + 1) int64
+    quads : (f, 4) int64
+        The mesh ``G`` lives on (before the step).
+    topo : EdgeTopology
+        Its edges (``SubdivisionStep.topo``).
+    find : callable, optional
+        :func:`_diag_lookup` of ``quads`` (reused across grids).
+
+    Returns
+    -------
+    (2 p + 1, 2 q + 1) int64
+    """
+    n, ne = topo.n_vertices, len(topo.edges)
+    find = find or _diag_lookup(quads, n)
+    p, q = G.shape[0] - 1, G.shape[1] - 1
+    H = np.empty((2 * p + 1, 2 * q + 1), dtype=np.int64)
+    H[0::2, 0::2] = G
+    H[1::2, 0::2] = n + edge_index(topo, G[:-1].ravel(), G[1:].ravel()).reshape(p, q + 1)
+    H[0::2, 1::2] = n + edge_index(topo, G[:, :-1].ravel(), G[:, 1:].ravel()).reshape(p + 1, q)
+    H[1::2, 1::2] = n + ne + find(G[:-1, :-1].ravel(), G[1:, 1:].ravel()).reshape(p, q)
+    return H
+
+
+def uniform_knots(m: int) -> np.ndarray:
+    """Unclamped uniform cubic knots ``-3 .. m + 3`` for ``m`` spans on ``[0, m]``."""
+    return np.arange(-3, m + 4, dtype=np.float64)
+
+
+def _tensor(Bu: np.ndarray, E: np.ndarray, Bv: np.ndarray) -> np.ndarray:
+    """Grid evaluation ``sum_ab Bu[r, a] E[a, b] Bv[c, b]`` -> ``(r, c, 3)``."""
+    T = np.tensordot(Bu, E, axes=(1, 0))                      # (r, b, 3)
+    return np.tensordot(T, Bv, axes=(1, 1)).transpose(0, 2, 1)
+
+
+def _design(x, m: int) -> np.ndarray:
+    return BSpline.design_matrix(np.asarray(x, np.float64), uniform_knots(m), 3).toarray()
+
+
+def clamp_uniform(poles: np.ndarray, m: int, axis: int) -> tuple:
+    """Re-express uniform unclamped cubic poles along ``axis`` with clamped knots.
+
+    Same spline on ``[0, m]``, same number of poles; the clamped end poles are the
+    end points of the surface, so pieces sharing a boundary curve share its poles.
+
+    Returns
+    -------
+    poles : same shape
+    knots : (m + 7,) float64 -- ``0, 0, 0, 0, 1, ..., m - 1, m, m, m, m``
+    """
+    t = np.r_[[0.0] * 3, np.arange(m + 1, dtype=np.float64), [float(m)] * 3]
+    g = (t[1:-3] + t[2:-2] + t[3:-1]) / 3.0                  # Greville abscissae
+    A_new = BSpline.design_matrix(g, t, 3).toarray()
+    R = np.linalg.solve(A_new, _design(g, m))                 # (m + 3, m + 3)
+    return np.moveaxis(np.tensordot(R, np.moveaxis(poles, axis, 0), axes=1), 0, axis), t
+
+
+def evaluate(piece: BSplinePiece, u, v, derivatives: bool = False):
+    """Points (and ``du``, ``dv``) of a piece at parameters ``u, v (k,)``.
+
+    Returns
+    -------
+    (k, 3) float64, or a tuple of three when ``derivatives``.
+    """
+    u, v = np.asarray(u, np.float64), np.asarray(v, np.float64)
+    nu, nv = len(piece.knots_u) - 4, len(piece.knots_v) - 4
+
+    def basis(x, t, n, d):
+        c = np.eye(n)
+        return BSpline(t, c, 3)(x, nu=d)                     # (k, n)
+    Bu, Bv = basis(u, piece.knots_u, nu, 0), basis(v, piece.knots_v, nv, 0)
+    flat = piece.poles.reshape(nu, -1)
+
+    def pair(A, B):
+        return ((A @ flat).reshape(len(u), nv, 3) * B[:, :, None]).sum(1)
+    if not derivatives:
+        return pair(Bu, Bv)
+    Du, Dv = basis(u, piece.knots_u, nu, 1), basis(v, piece.knots_v, nv, 1)
+    return pair(Bu, Bv), pair(Du, Bv), pair(Bu, Dv)
+
+
+class _Level:
+    """One subdivision level: positions, quads and the lookups the outer ring needs."""
+
+    def __init__(self, V, Q, sharp_edges):
+        self.V, self.Q = V, Q
+        n = self.n = len(V)
+        self.topo = edge_topology(Q, n)
+        self.sharp = _sharp_mask(self.topo, sharp_edges)
+        self.find = _diag_lookup(Q, n)
+        a, b = Q.ravel(), np.roll(Q, -1, axis=1).ravel()
+        keys = np.minimum(a, b) * n + np.maximum(a, b)
+        order = np.argsort(keys, kind="stable")
+        self.keys = keys[order]
+        self.a = a[order]
+        self.face = np.repeat(np.arange(len(Q)), 4)[order]
+        self.out_a = np.roll(Q, 1, axis=1).ravel()[order]     # c_{k-1}: beside c_k
+        self.out_b = np.roll(Q, -2, axis=1).ravel()[order]    # c_{k+2}: beside c_{k+1}
+
+    def across(self, a, b, own):
+        """Vertices beside ``a`` and ``b`` in the face across edge ``(a, b)`` from
+        face ``own``: ``(oa, ob, sharp)``, -1 where the edge is sharp."""
+        k = np.minimum(a, b) * self.n + np.maximum(a, b)
+        lo = np.searchsorted(self.keys, k)
+        e = edge_index(self.topo, a, b)
+        sharp = self.sharp[e]
+        other = np.where(self.face[np.minimum(lo, len(self.keys) - 1)] == own, lo + 1, lo)
+        other = np.minimum(other, len(self.keys) - 1)
+        same = self.a[other] == a
+        oa = np.where(same, self.out_a[other], self.out_b[other])
+        ob = np.where(same, self.out_b[other], self.out_a[other])
+        return np.where(sharp, -1, oa), np.where(sharp, -1, ob), sharp
+
+
+def _side(lv: _Level, Gs: np.ndarray):
+    """Outer ring beside the border ``Gs[:, 0]`` (inner row ``Gs[:, 1]``).
+
+    Returns ``(points (m + 1, 3), ids (m + 1,), sharp (m,), conflict (m + 1,))``;
+    ids are -1 for phantom points ``2 P_0 - P_1``.
+    """
+    V = lv.V
+    a, b = Gs[:-1, 0], Gs[1:, 0]
+    own = lv.find(a, Gs[1:, 1])
+    oa, ob, sharp = lv.across(a, b, own)
+    ghost = 2.0 * V[Gs[:, 0]] - V[Gs[:, 1]]
+    m = len(a)
+    right = np.r_[oa, -2]            # candidate of vertex i from edge (i, i + 1)
+    left = np.r_[-2, ob]             # ... from edge (i - 1, i)
+    sh_r = np.r_[sharp, False]
+    sh_l = np.r_[False, sharp]
+    has_r = np.r_[np.ones(m, bool), False]
+    has_l = np.r_[False, np.ones(m, bool)]
+
+    def cand(ids, sh):
+        return np.where(sh[:, None], ghost, V[np.maximum(ids, 0)])
+    pr, pl = cand(right, sh_r), cand(left, sh_l)
+    both = has_r & has_l
+    conflict = both & ((sh_r != sh_l) | (~sh_r & (right != left)))
+    pts = np.where(has_r[:, None], pr, pl)
+    pts[conflict] = 0.5 * (pr[conflict] + pl[conflict])
+    ids = np.where(has_r, np.where(sh_r, -1, right), np.where(sh_l, -1, left))
+    ids[conflict] = -1
+    return pts, ids, sharp, conflict
+
+
+def _extended(lv: _Level, G: np.ndarray):
+    """Uniform B-spline poles ``(M + 3, N + 3, 3)`` of a piece grid, and whether
+    every outer-ring point was found unambiguously."""
+    V = lv.V
+    M, N = G.shape[0] - 1, G.shape[1] - 1
+    E = np.zeros((M + 3, N + 3, 3))
+    ids = np.full((M + 3, N + 3), -1, dtype=np.int64)
+    E[1:-1, 1:-1] = V[G]
+    ids[1:-1, 1:-1] = G
+    clean = True
+    sharp_at = {}
+    for name, Gs, Ev, Iv in (("b", G, E[1:-1, 0], ids[1:-1, 0]),
+                             ("t", G[:, ::-1], E[1:-1, -1], ids[1:-1, -1]),
+                             ("l", G.T, E[0, 1:-1], ids[0, 1:-1]),
+                             ("r", G[::-1].T, E[-1, 1:-1], ids[-1, 1:-1])):
+        pts, oid, sharp, conflict = _side(lv, Gs)
+        Ev[:], Iv[:] = pts, oid
+        sharp_at[name] = (sharp[0], sharp[-1])
+        clean &= not conflict.any()
+    # corners: views with the corner at [0, 0]
+    for Ev, Iv, Gv, s_j, s_i in (
+            (E, ids, G, sharp_at["b"][0], sharp_at["l"][0]),
+            (E[::-1], ids[::-1], G[::-1], sharp_at["b"][1], sharp_at["r"][0]),
+            (E[:, ::-1], ids[:, ::-1], G[:, ::-1], sharp_at["t"][0], sharp_at["l"][1]),
+            (E[::-1, ::-1], ids[::-1, ::-1], G[::-1, ::-1], sharp_at["t"][1],
+             sharp_at["r"][1])):
+        if s_j:                                  # row j = -1 is phantom
+            Ev[0, 0] = 2.0 * Ev[0, 1] - Ev[0, 2]
+            continue
+        if s_i:                                  # column i = -1 is phantom
+            Ev[0, 0] = 2.0 * Ev[1, 0] - Ev[2, 0]
+            continue
+        x, y = Iv[0, 1], Iv[1, 0]
+        f = lv.find(np.array([x]), np.array([y]))[0] if min(x, y) >= 0 else -1
+        c = Gv[0, 0]
+        if f >= 0 and c in lv.Q[f]:
+            q = lv.Q[f]
+            k = int(np.flatnonzero(q == c)[0])
+            d = q[(k + 2) % 4]
+            Ev[0, 0], Iv[0, 0] = V[d], d
+        else:
+            Ev[0, 0] = Ev[0, 1] + Ev[1, 0] - Ev[1, 1]
+            clean = False
+    return E, clean
+
+
+def _levels(net: ControlNet, level: int, extra: int):
+    """Subdivide ``level + extra`` times, tracking every piece's grid.
+
+    Returns ``(lv_k, grids_k, V_s, grids_s, L_s)``: the level-``level`` mesh with its
+    grids, and the sample level's positions, grids and limit matrix.
+    """
+    V, Q = np.asarray(net.vertices, np.float64), np.asarray(net.quads, np.int64)
+    se = np.asarray(net.sharp_edges, np.int64).reshape(-1, 2)
+    cr = np.asarray(net.corners, bool)
+    pieces = piece_grids(Q, net.face_patch)
+    grids = [G for _, G in pieces]
+    lv_k = grids_k = None
+    for step in range(level + extra + 1):
+        if step == level:
+            lv_k, grids_k = _Level(V, Q, se), list(grids)
+        if step == level + extra:
+            break
+        st = subdivision_step(Q, len(V), se, cr)
+        find = _diag_lookup(Q, len(V))
+        grids = [refine_grid(G, Q, st.topo, find) for G in grids]
+        V, Q, se, cr = st.S @ V, st.quads, st.sharp_edges, st.corners
+    L = limit_matrix(Q, len(V), se, cr)
+    return [p for p, _ in pieces], lv_k, grids_k, L @ V, grids
+
+
+def _spans_to_samples(spans: np.ndarray, r: int) -> np.ndarray:
+    """Samples ``((r M + 1) x (r N + 1))`` in the closure of the marked spans ``(M, N)``."""
+    M, N = spans.shape
+    out = np.zeros((r * M + 1, r * N + 1), bool)
+    for du in range(r + 1):
+        for dv in range(r + 1):
+            out[du:du + r * M:r, dv:dv + r * N:r] |= spans
+    return out
+
+
+def _fit_irregular(E, Bu, Bv, S, bad_span, r):
+    """Refit the poles acting on irregular spans to the exact samples.
+
+    ``E (M + 3, N + 3, 3)`` uniform poles, ``Bu (r M + 1, M + 3)``, ``Bv`` design
+    matrices at the sample parameters, ``S (r M + 1, r N + 1, 3)`` exact samples,
+    ``bad_span (M, N)``. The poles whose support meets a bad span are refitted to
+    the samples over their whole support, so the spans next to the irregular ones
+    become approximate too.
+    """
+    M, N = bad_span.shape
+    pad = np.zeros((M + 6, N + 6), bool)         # pole a acts on spans a - 3 .. a
+    pad[3:-3, 3:-3] = bad_span
+    free = np.zeros((M + 3, N + 3), bool)
+    for du in range(4):
+        for dv in range(4):
+            free |= pad[du:du + M + 3, dv:dv + N + 3]
+    touched = np.zeros((M + 6, N + 6), bool)
+    for du in range(4):
+        for dv in range(4):
+            touched[du:du + M + 3, dv:dv + N + 3] |= free
+    rows = np.argwhere(_spans_to_samples(touched[3:-3, 3:-3], r))
+    fr = np.argwhere(free)
+    Efix = E.copy()
+    Efix[fr[:, 0], fr[:, 1]] = 0.0
+    fixed = _tensor(Bu, Efix, Bv)[rows[:, 0], rows[:, 1]]
+    A = Bu[rows[:, 0]][:, fr[:, 0]] * Bv[rows[:, 1]][:, fr[:, 1]]
+    X = np.linalg.lstsq(A, S[rows[:, 0], rows[:, 1]] - fixed, rcond=None)[0]
+    E = E.copy()
+    E[fr[:, 0], fr[:, 1]] = X
+    return E
+
+
+def extract_bsplines(net: ControlNet, level: int = DEFAULT_LEVEL, *,
+                     sample_levels: int = 2) -> BSplineSet:
+    """Bicubic B-spline pieces of the limit surface of ``net``, with a seam report.
+
+    Parameters
+    ----------
+    net : ControlNet
+    level : int
+        Subdivision steps before reading off the pieces (>= 0); each piece has
+        ``(2^level p + 3) x (2^level q + 3)`` poles. Higher levels shrink the
+        irregular spans around extraordinary vertices.
+    sample_levels : int
+        Further steps for the exact limit samples that irregular spans are fitted
+        to and every deviation is measured at (``(2^sample_levels + 1)^2`` per span).
+
+    Returns
+    -------
+    BSplineSet
+    """
+    if int(level) != level or level < 0:
+        raise ValueError(f"level: expected an integer >= 0, got {level!r}")
+    if int(sample_levels) != sample_levels or sample_levels < 1:
+        raise ValueError(f"sample_levels: expected an integer >= 1, got {sample_levels!r}")
+    diag = net.diagonal if net.diagonal > 0 else 1.0
+    patches, lv, grids_k, Vs, grids_s = _levels(net, int(level), int(sample_levels))
+    r = 2 ** int(sample_levels)
+    pieces, border = [], []
+    for pid, (patch, G, Gs) in enumerate(zip(patches, grids_k, grids_s)):
+        M, N = G.shape[0] - 1, G.shape[1] - 1
+        E, clean = _extended(lv, G)
+        u, v = np.arange(r * M + 1) / r, np.arange(r * N + 1) / r
+        Bu, Bv = _design(u, M), _design(v, N)
+        S = Vs[Gs]
+        err = np.linalg.norm(_tensor(Bu, E, Bv) - S, axis=2)
+        bad = _span_max(err, M, N, r) > EXACT_TOL * diag
+        exact = not bad.any()
+        if not exact:
+            E = _fit_irregular(E, Bu, Bv, S, bad, r)
+            err = np.linalg.norm(_tensor(Bu, E, Bv) - S, axis=2)
+        poles, ku = clamp_uniform(E, M, 0)
+        poles, kv = clamp_uniform(poles, N, 1)
+        pieces.append(BSplinePiece(poles, ku, kv, int(patch), exact and clean,
+                                   float(err.max() / diag)))
+        border.append(_border_samples(pid, Gs, r, err / diag))
+    seams = _seams(pieces, border, net)
+    dev = max((p.deviation for p in pieces), default=0.0)
+    per_patch: dict = {}
+    for p in pieces:
+        per_patch[p.patch] = per_patch.get(p.patch, 0) + 1
+    report = {"level": int(level), "sample_levels": int(sample_levels),
+              "n_pieces": len(pieces), "n_exact": sum(p.exact for p in pieces),
+              "max_deviation": float(dev),
+              "pieces_per_patch": {int(k): int(c) for k, c in per_patch.items() if c > 1}}
+    return BSplineSet(pieces, seams, report)
+
+
+def _span_max(err: np.ndarray, M: int, N: int, r: int) -> np.ndarray:
+    """Largest sample error over each span's closed ``(r + 1) x (r + 1)`` samples."""
+    iu = np.arange(M)[:, None] * r + np.arange(r + 1)[None, :]      # (M, r + 1)
+    iv = np.arange(N)[:, None] * r + np.arange(r + 1)[None, :]
+    return err[iu[:, :, None, None], iv[None, None, :, :]].max(axis=(1, 3))
+
+
+def _border_samples(pid: int, Gs: np.ndarray, r: int, err: np.ndarray):
+    """Sample-level vertex ids, parameters and errors along a piece's border."""
+    I, J = np.meshgrid(np.arange(Gs.shape[0]), np.arange(Gs.shape[1]), indexing="ij")
+    on = (I == 0) | (J == 0) | (I == Gs.shape[0] - 1) | (J == Gs.shape[1] - 1)
+    return (np.full(on.sum(), pid), Gs[on], I[on] / r, J[on] / r, err[on])
+
+
+def _normals(piece: BSplinePiece, u, v):
+    P, du, dv = evaluate(piece, u, v, derivatives=True)
+    n = np.cross(du, dv)
+    return P, n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+
+
+def _seams(pieces: list, border: list, net: ControlNet) -> list:
+    """Continuity report of every pair of pieces sharing at least one border segment."""
+    pid, vid, u, v, err = (np.concatenate(x) for x in zip(*border))
+    P = np.empty((len(pid), 3))
+    Nrm = np.empty((len(pid), 3))
+    for k, piece in enumerate(pieces):
+        m = pid == k
+        P[m], Nrm[m] = _normals(piece, u[m], v[m])
+    order = np.lexsort((pid, vid))
+    pid, vid, P, Nrm, err = pid[order], vid[order], P[order], Nrm[order], err[order]
+    starts = np.flatnonzero(np.r_[True, vid[1:] != vid[:-1]])
+    counts = np.diff(np.r_[starts, len(vid)])
+    pairs = []                                           # (entry i, entry j)
+    for c in np.unique(counts[counts > 1]):
+        s = starts[counts == c]
+        for x in range(c):
+            for y in range(x + 1, c):
+                pairs.append(np.stack([s + x, s + y], 1))
+    if not pairs:
+        return []
+    pr = np.concatenate(pairs)
+    pr = pr[pid[pr[:, 0]] != pid[pr[:, 1]]]
+    gap = np.linalg.norm(P[pr[:, 0]] - P[pr[:, 1]], axis=1) / max(net.diagonal, 1e-300)
+    cos = np.abs(np.einsum("ij,ij->i", Nrm[pr[:, 0]], Nrm[pr[:, 1]]))
+    ang = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
+    dev = np.maximum(err[pr[:, 0]], err[pr[:, 1]])
+    key = np.sort(np.stack([pid[pr[:, 0]], pid[pr[:, 1]]], 1), axis=1)
+    uk, inv, cnt = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    inv = inv.ravel()
+    curves, sharp = _piece_curves(net)
+    out = []
+    for g in np.flatnonzero(cnt > 1):                  # a shared point is not a seam
+        m = inv == g
+        a, b = (int(x) for x in uk[g])
+        shared = curves[a].keys() & curves[b].keys()
+        out.append({"pieces": [a, b], "patches": [pieces[a].patch, pieces[b].patch],
+                    "curves": sorted({curves[a][e] for e in shared} - {-1}),
+                    "crease": bool(shared) and all(e in sharp for e in shared),
+                    "gap": float(gap[m].max()), "angle": float(ang[m].max()),
+                    "deviation": float(dev[m].max())})
+    return out
+
+
+def _piece_curves(net: ControlNet):
+    """Per piece: {level-0 border edge key: curve index or -1}; and the sharp keys."""
+    n = len(net.vertices)
+    edge_curve = {}
+    for c, ids in enumerate(net.curve_vids):
+        ids = np.asarray(ids, np.int64)
+        for k in (np.minimum(ids[:-1], ids[1:]) * n + np.maximum(ids[:-1], ids[1:])).tolist():
+            edge_curve[k] = c
+    se = np.asarray(net.sharp_edges, np.int64).reshape(-1, 2)
+    sharp = set((se.min(1) * n + se.max(1)).tolist())
+    out = []
+    for _, G in piece_grids(net.quads, net.face_patch):
+        ring = np.r_[G[:, 0], G[-1, 1:], G[-2::-1, -1], G[0, -2::-1]]
+        a, b = ring[:-1], ring[1:]
+        keys = (np.minimum(a, b) * n + np.maximum(a, b)).tolist()
+        out.append({k: edge_curve.get(k, -1) for k in keys})
+    return out, sharp
