@@ -41,6 +41,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ._atomic import atomic_path
+from .cad import CAD_FORMATS
 from .errors import CurvenetError, InvalidParameterError, MissingDependencyError
 
 __all__ = ["BatchOptions", "BatchResult", "LocalExecutor", "DaskExecutor", "run_batch",
@@ -62,9 +63,10 @@ TILE_SIZE = (360, 300)
 class BatchOptions:
     """Settings of every file's surfacing (the arguments of :func:`curvenet.pipeline.surface`).
 
-    ``format`` is the output mesh format; ``neural_options`` a tuple of ``(name, value)``
-    pairs; ``points`` forces the point-sample reading (``--points``). Two batches with equal
-    options give equal outputs for equal inputs; their hash
+    ``format`` is the output format (a mesh, or ``step`` / ``3dm`` B-spline faces);
+    ``neural_options`` a tuple of ``(name, value)`` pairs; ``points`` forces the
+    point-sample reading (``--points``). Two batches with equal options give equal
+    outputs for equal inputs; their hash
     (:meth:`digest`) is recorded in the manifest.
     """
 
@@ -179,7 +181,10 @@ def _surface_file(local: str, options: BatchOptions, tmp: str, *, preview, tile,
     t = time.perf_counter()
     fid = stroke_fidelity(res.mesh, res.sketch if res.sketch is not None else res.network)
     out["t_fidelity"] = time.perf_counter() - t
-    data = res.mesh.export(file_type=options.format)
+    if "." + options.format in CAD_FORMATS:
+        data = _cad_bytes(res, Path(tmp, f"out.{options.format}"), out)
+    else:
+        data = res.mesh.export(file_type=options.format)
     cov = res.diagnostics.get("coverage")
     out.update(route=res.method, decision=res.diagnostics.get("decision", ""),
                patches=res.diagnostics.get("patches"),
@@ -205,6 +210,18 @@ def _surface_file(local: str, options: BatchOptions, tmp: str, *, preview, tile,
     if preview or tile:
         out["t_preview"] = time.perf_counter() - t
     return out
+
+
+def _cad_bytes(res, path: Path, out: dict) -> bytes:
+    """Write the B-spline CAD file (STEP AP214 / 3DM) and add its figures to the row."""
+    res.save(path)
+    cad = res.diagnostics["cad"]
+    smooth = [s["angle"] for s in cad["seams"] if not s["crease"]]
+    out.update(cad_faces=cad["pieces"]["n_pieces"], cad_exact=cad["pieces"]["n_exact"],
+               cad_deviation=cad["pieces"]["max_deviation"],
+               cad_gap=max((s["gap"] for s in cad["seams"]), default=0.0),
+               cad_g1=max(smooth, default=0.0))
+    return path.read_bytes()
 
 
 def _worker_name() -> str:

@@ -110,10 +110,14 @@ def build_parser() -> argparse.ArgumentParser:
 
     s = sub.add_parser("surface", help="surface a sketch, network or patch set")
     s.add_argument("inputs", nargs="+", metavar="INPUT")
-    s.add_argument("-o", "--output", help="mesh file (.obj .ply .stl .off .glb)")
+    s.add_argument("-o", "--output", help="mesh file (.obj .ply .stl .off .glb) or B-spline "
+                                          "CAD file (.step .stp .3dm, needs curvenet[cad])")
     s.add_argument("--out-dir", help="batch mode: write INPUT-stem.<--format> here")
-    s.add_argument("--format", default="obj", choices=("obj", "ply", "stl", "off", "glb"),
-                   help="mesh format in batch mode (default obj)")
+    s.add_argument("--format", default="obj",
+                   choices=("obj", "ply", "stl", "off", "glb", "step", "3dm"),
+                   help="output format in batch mode (default obj)")
+    s.add_argument("--step-schema", choices=("AP214", "AP242"), default="AP214",
+                   help="STEP application protocol (default AP214)")
     s.add_argument("--jobs", type=_positive_int, default=1, help="batch: parallel processes")
     s.add_argument("--scheduler", metavar="ADDRESS",
                    help="batch: send the files to this Dask scheduler (tcp://host:8786) "
@@ -237,7 +241,7 @@ def _surface_one(inp: str, out: str, args) -> dict:
                       refine=args.refine, quality=args.quality, device=args.device,
                       seed=args.seed, progress=not args.no_progress,
                       neural_options=_neural_options(args), points=_points(args))
-        res.save(out)
+        res.save(out, schema=args.step_schema)
         if args.preview:
             from .preview import render_preview
             prev = args.preview if args.output else str(Path(out).with_suffix(".png"))
@@ -249,14 +253,45 @@ def _surface_one(inp: str, out: str, args) -> dict:
                 "reading": res.diagnostics.get("reading", ""),
                 "snap": res.diagnostics.get("snap", {}).get("summary", ""),
                 "regions": res.decision.explain_regions(),
-                "fidelity": res.diagnostics.get("fidelity")}
+                "fidelity": res.diagnostics.get("fidelity"),
+                "cad": res.diagnostics.get("cad")}
     except CurvenetError as err:
         return {"input": inp, "output": out, "status": "error", "error": _naming(err, inp),
                 "seconds": time.perf_counter() - t0}
 
 
+def _cad_lines(cad: dict) -> list:
+    """``--explain`` lines of a CAD export: pieces, file check, the worst seams."""
+    pr, fr = cad["pieces"], cad["file"]
+    lines = [f"cad: {pr['n_pieces']} B-spline faces ({pr['n_exact']} exact, level "
+             f"{pr['level']}), max deviation {pr['max_deviation']:.2e} of the diagonal"]
+    if "valid" in fr:
+        lines.append(f"cad: {fr['shells']} shells, {fr['solids']} solids, {fr['free_edges']} "
+                     f"free edges, valid {fr['valid']}, sewing tolerance "
+                     f"{fr['sew_tolerance']:.2e}")
+    seams = cad["seams"]
+    smooth = [s for s in seams if not s["crease"]]
+    lines.append(f"cad: {len(seams)} seams ({len(seams) - len(smooth)} creases), largest G0 gap "
+                 f"{max((s['gap'] for s in seams), default=0.0):.1e} of the diagonal, largest "
+                 f"G1 angle off creases {max((s['angle'] for s in smooth), default=0.0):.2f} deg")
+    for s in sorted(smooth, key=lambda s: -s["angle"])[:_SEAMS_SHOWN]:
+        lines.append(f"seam patches {s['patches'][0]}-{s['patches'][1]} curves {s['curves']}: "
+                     f"G0 {s['gap']:.1e}, G1 {s['angle']:.2f} deg, deviation "
+                     f"{s['deviation']:.1e}")
+    return lines
+
+
+#: Smooth seams listed by ``--explain`` (largest G1 angle first).
+_SEAMS_SHOWN = 10
+
+
 def _cmd_surface(args) -> int:
-    from .pipeline import MESH_FORMATS
+    from .cad import require_cad
+    from .pipeline import CAD_FORMATS, MESH_FORMATS
+    suffix = (Path(args.output).suffix.lower() if args.out_dir is None and args.output
+              else "." + args.format)
+    if suffix in CAD_FORMATS:
+        require_cad(suffix)                       # before any work: say which extra
     if args.out_dir is not None:
         return _cmd_surface_batch(args)
     for flag in ("scheduler", "report", "preview_dir", "skip_existing"):
@@ -266,9 +301,9 @@ def _cmd_surface(args) -> int:
         raise InvalidParameterError("surface: give -o MESH (one input) or --out-dir DIR")
     if len(args.inputs) > 1:
         raise InvalidParameterError("surface: several inputs need --out-dir DIR, not -o")
-    if Path(args.output).suffix.lower() not in MESH_FORMATS:
-        raise InvalidParameterError(f"output {args.output}: unknown mesh format; use one "
-                                    f"of {', '.join(MESH_FORMATS)}")
+    if suffix not in MESH_FORMATS + CAD_FORMATS:
+        raise InvalidParameterError(f"output {args.output}: unknown format; use one "
+                                    f"of {', '.join(MESH_FORMATS + CAD_FORMATS)}")
     given = [*args.inputs, args.patches]
     check_output_path(args.output, inputs=given, what="-o")
     if args.preview:
@@ -290,6 +325,8 @@ def _cmd_surface(args) -> int:
         if row.get("fidelity"):
             from .evaluate import format_fidelity
             print(format_fidelity(row["fidelity"]))
+        if row.get("cad"):
+            print("\n".join(_cad_lines(row["cad"])))
     return 130 if row["interrupted"] else 0
 
 

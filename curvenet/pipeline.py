@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ._atomic import atomic_path
+from .cad import CAD_FORMATS
 from .core.result import MeshResult
 from .errors import CurvenetError, InvalidParameterError, SketchFormatError
 from .network import CurveNetwork
@@ -26,8 +27,8 @@ from .sketch import Sketch
 from .surfacers import (SurfaceInput, SurfaceSettings, Surfacer, get_surfacer,
                         surfacer_names)
 
-__all__ = ["SurfaceResult", "surface", "patches", "load_source", "MESH_FORMATS",
-           "AUTO_MIN_COVERAGE", "write_mesh"]
+__all__ = ["SurfaceResult", "surface", "patches", "load_source", "MESH_FORMATS", "CAD_FORMATS",
+           "AUTO_MIN_COVERAGE", "write_mesh", "export_cad"]
 
 MESH_FORMATS = (".obj", ".ply", ".stl", ".off", ".glb")
 #: methods that name a route; every registered surfacer name is a method too
@@ -66,6 +67,9 @@ class SurfaceResult:
         Per face, an index into ``routes``: the route that made it.
     routes : tuple of str
         Route names of ``face_route`` (``("classical", "neural")``).
+    control_net : surfacing.bspline.ControlNet or None
+        The Catmull-Clark route's fitted control mesh (what :func:`export_cad` reads);
+        ``diagnostics["cad"]`` holds the export report after a STEP / 3DM save.
     """
 
     mesh: object
@@ -79,6 +83,7 @@ class SurfaceResult:
     wires: list = field(default_factory=list)
     face_route: np.ndarray | None = None
     routes: tuple = ()
+    control_net: object = None
 
     @property
     def interrupted(self) -> bool:
@@ -87,12 +92,17 @@ class SurfaceResult:
         return bool(neural.get("interrupted")
                     or neural.get("creases", {}).get("interrupted"))
 
-    def save(self, path) -> Path:
+    def save(self, path, *, schema: str = "AP214") -> Path:
         """Write the mesh atomically; the format follows the extension.
 
         With wires or several routes, OBJ gets one group per route and the wires as
         ``l`` records, PLY a ``route`` face property (:func:`curvenet.routed.write_routed`).
+        ``.step`` / ``.stp`` (``schema`` AP214 or AP242) and ``.3dm`` write B-spline
+        faces (:func:`export_cad`, needs ``pip install 'curvenet[cad]'``).
         """
+        if Path(path).suffix.lower() in CAD_FORMATS:
+            self.diagnostics["cad"] = export_cad(path, self, schema=schema)
+            return Path(path)
         if not self.wires and len(self.routes) < 2:
             return write_mesh(path, self.mesh)
         from .routed import write_routed
@@ -118,6 +128,30 @@ def write_mesh(path, mesh) -> Path:
     with atomic_path(path) as tmp:
         mesh.export(tmp, file_type=path.suffix.lower()[1:])
     return path
+
+
+def export_cad(path, result: SurfaceResult, *, schema: str = "AP214",
+               level: int | None = None) -> dict:
+    """Write the classical surface of ``result`` as B-spline faces (STEP or 3DM).
+
+    Returns
+    -------
+    dict
+        ``pieces`` (B-spline report of :func:`surfacing.bspline.extract_bsplines`),
+        ``seams`` (G0 gap, G1 angle and deviation per seam), ``file`` (what the
+        writer reports: faces, shells, solids, free edges, validity).
+    """
+    from . import cad
+    suffix = Path(path).suffix.lower()
+    cad.require_cad(suffix)
+    if result.control_net is None:
+        raise InvalidParameterError(
+            f"output {path}: CAD export needs the classical Catmull-Clark route "
+            f"(this surface came from {result.method})")
+    from curvenet.surfacing.bspline import DEFAULT_LEVEL, extract_bsplines
+    bset = extract_bsplines(result.control_net, DEFAULT_LEVEL if level is None else level)
+    file_report = cad.write_cad(path, bset, schema=schema)
+    return {"pieces": bset.report, "seams": bset.seams, "file": file_report}
 
 
 def _is_network_json(path: Path) -> bool:
@@ -457,7 +491,8 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
                                timings=timings, diag=diag)
     if len(res.faces) == 0:
         raise CurvenetError(f"the {name} route produced an empty surface")
-    out = SurfaceResult(res.to_trimesh(), name, sketch, net, ps, timings, diag, decision)
+    out = SurfaceResult(res.to_trimesh(), name, sketch, net, ps, timings, diag, decision,
+                        control_net=getattr(res, "control_net", None))
     if decision.regions:
         from .hybrid import assemble
         assemble(out, res, plan, settings, _run)

@@ -71,7 +71,6 @@ class PatchMeshResult(MeshResult):
     control_vertices: np.ndarray | None = None
     control_quads: np.ndarray | None = None
     control_net: ControlNet | None = None
-    control_net: ControlNet | None = None
 
 
 def _quads_to_tris(q: np.ndarray) -> np.ndarray:

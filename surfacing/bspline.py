@@ -105,7 +105,9 @@ class BSplineSet:
         (network curves along it), ``crease``, ``gap`` (G0, fraction of the
         diagonal), ``angle`` (G1, degrees), ``deviation``.
     report : dict
-        ``level``, ``n_pieces``, ``n_exact``, ``max_deviation``, ``pieces_per_patch``.
+        ``level``, ``sample_levels``, ``diagonal`` (model units), ``n_pieces``,
+        ``n_exact``, ``max_deviation``, ``pieces_per_patch`` (patches of more than one
+        piece).
     """
 
     pieces: list
@@ -440,7 +442,7 @@ def _fit_irregular(E, Bu, Bv, S, bad_span, r):
 
 
 def extract_bsplines(net: ControlNet, level: int = DEFAULT_LEVEL, *,
-                     sample_levels: int = 2) -> BSplineSet:
+                     sample_levels: int = 3) -> BSplineSet:
     """Bicubic B-spline pieces of the limit surface of ``net``, with a seam report.
 
     Parameters
@@ -451,8 +453,10 @@ def extract_bsplines(net: ControlNet, level: int = DEFAULT_LEVEL, *,
         ``(2^level p + 3) x (2^level q + 3)`` poles. Higher levels shrink the
         irregular spans around extraordinary vertices.
     sample_levels : int
-        Further steps for the exact limit samples that irregular spans are fitted
-        to and every deviation is measured at (``(2^sample_levels + 1)^2`` per span).
+        Further steps for the exact limit samples that every deviation is measured
+        at (``(2^sample_levels + 1)^2`` per span); irregular spans are fitted to every
+        other sample (one level coarser), so the measure also sees the fit between
+        its points.
 
     Returns
     -------
@@ -460,8 +464,8 @@ def extract_bsplines(net: ControlNet, level: int = DEFAULT_LEVEL, *,
     """
     if int(level) != level or level < 0:
         raise ValueError(f"level: expected an integer >= 0, got {level!r}")
-    if int(sample_levels) != sample_levels or sample_levels < 1:
-        raise ValueError(f"sample_levels: expected an integer >= 1, got {sample_levels!r}")
+    if int(sample_levels) != sample_levels or sample_levels < 2:
+        raise ValueError(f"sample_levels: expected an integer >= 2, got {sample_levels!r}")
     diag = net.diagonal if net.diagonal > 0 else 1.0
     patches, lv, grids_k, Vs, grids_s = _levels(net, int(level), int(sample_levels))
     r = 2 ** int(sample_levels)
@@ -476,7 +480,7 @@ def extract_bsplines(net: ControlNet, level: int = DEFAULT_LEVEL, *,
         bad = _span_max(err, M, N, r) > EXACT_TOL * diag
         exact = not bad.any()
         if not exact:
-            E = _fit_irregular(E, Bu, Bv, S, bad, r)
+            E = _fit_irregular(E, Bu[::2], Bv[::2], S[::2, ::2], bad, r // 2)
             err = np.linalg.norm(_tensor(Bu, E, Bv) - S, axis=2)
         poles, ku = clamp_uniform(E, M, 0)
         poles, kv = clamp_uniform(poles, N, 1)
@@ -488,7 +492,7 @@ def extract_bsplines(net: ControlNet, level: int = DEFAULT_LEVEL, *,
     per_patch: dict = {}
     for p in pieces:
         per_patch[p.patch] = per_patch.get(p.patch, 0) + 1
-    report = {"level": int(level), "sample_levels": int(sample_levels),
+    report = {"level": int(level), "sample_levels": int(sample_levels), "diagonal": diag,
               "n_pieces": len(pieces), "n_exact": sum(p.exact for p in pieces),
               "max_deviation": float(dev),
               "pieces_per_patch": {int(k): int(c) for k, c in per_patch.items() if c > 1}}
@@ -504,9 +508,9 @@ def _span_max(err: np.ndarray, M: int, N: int, r: int) -> np.ndarray:
 
 def _border_samples(pid: int, Gs: np.ndarray, r: int, err: np.ndarray):
     """Sample-level vertex ids, parameters and errors along a piece's border."""
-    I, J = np.meshgrid(np.arange(Gs.shape[0]), np.arange(Gs.shape[1]), indexing="ij")
-    on = (I == 0) | (J == 0) | (I == Gs.shape[0] - 1) | (J == Gs.shape[1] - 1)
-    return (np.full(on.sum(), pid), Gs[on], I[on] / r, J[on] / r, err[on])
+    ii, jj = np.meshgrid(np.arange(Gs.shape[0]), np.arange(Gs.shape[1]), indexing="ij")
+    on = (ii == 0) | (jj == 0) | (ii == Gs.shape[0] - 1) | (jj == Gs.shape[1] - 1)
+    return (np.full(on.sum(), pid), Gs[on], ii[on] / r, jj[on] / r, err[on])
 
 
 def _normals(piece: BSplinePiece, u, v):
@@ -538,7 +542,7 @@ def _seams(pieces: list, border: list, net: ControlNet) -> list:
     pr = np.concatenate(pairs)
     pr = pr[pid[pr[:, 0]] != pid[pr[:, 1]]]
     gap = np.linalg.norm(P[pr[:, 0]] - P[pr[:, 1]], axis=1) / max(net.diagonal, 1e-300)
-    cos = np.abs(np.einsum("ij,ij->i", Nrm[pr[:, 0]], Nrm[pr[:, 1]]))
+    cos = np.einsum("ij,ij->i", Nrm[pr[:, 0]], Nrm[pr[:, 1]])
     ang = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
     dev = np.maximum(err[pr[:, 0]], err[pr[:, 1]])
     key = np.sort(np.stack([pid[pr[:, 0]], pid[pr[:, 1]]], 1), axis=1)
