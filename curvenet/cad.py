@@ -164,12 +164,13 @@ def write_step(path, bset, *, schema: str = "AP214") -> dict:
         raise InvalidParameterError(f"schema: {schema!r} is not one of {tuple(STEP_SCHEMAS)}")
     from OCP.IFSelect import IFSelect_RetDone
     from OCP.Interface import Interface_Static
-    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Writer
+    from OCP.STEPControl import STEPControl_AsIs, STEPControl_Controller, STEPControl_Writer
 
     diag = bset.report.get("diagonal", 1.0)
     gap = max((s["gap"] for s in bset.seams), default=0.0)
     tol = max(SEW_TOL, 2.0 * gap) * diag
     shape, free = sew(occ_faces(bset.pieces), tol)
+    STEPControl_Controller.Init_s()              # registers the parameter the schema sets
     Interface_Static.SetCVal_s("write.step.schema", STEP_SCHEMAS[schema])
     writer = STEPControl_Writer()
     writer.Transfer(shape, STEPControl_AsIs)
