@@ -137,5 +137,13 @@ def test_cli_step_explain(tmp_path, capsys):
                  "--no-progress"]) == 0
     out = capsys.readouterr().out
     assert "cad: 6 B-spline faces (6 exact" in out and "valid True" in out
-    assert main(["surface", str(src), "--out-dir", str(tmp_path / "d"), "--format", "3dm",
-                 "--no-progress"]) == 0 or "rhino3dm" not in sys.modules
+    src2 = tmp_path / "sheet.json"
+    save_network(src2, shapes.grid_sheet().network)
+    rep = tmp_path / "r.json"
+    assert main(["surface", str(src), str(src2), "--out-dir", str(tmp_path / "d"), "--format",
+                 "step", "--report", str(rep), "--no-progress"]) == 0
+    from curvenet import cad
+    faces = [cad.shape_report(cad.read_step(tmp_path / "d" / f"{n}.step"))["faces"]
+             for n in ("box", "sheet")]
+    assert faces == [6, 9]
+    assert '"cad_faces": 6' in rep.read_text().replace("\n", " ")
