@@ -30,11 +30,11 @@ from .catmull_clark import _sharp_mask, edge_index, edge_topology, subdivision_s
 from .limit import limit_matrix
 
 __all__ = ["ControlNet", "BSplinePiece", "BSplineSet", "piece_grids", "refine_grid",
-           "extract_bsplines", "uniform_knots", "clamp_uniform", "evaluate",
+           "extract_bsplines", "uniform_knots", "clamp_uniform", "evaluate", "project",
            "DEFAULT_LEVEL", "EXACT_TOL"]
 
 #: Subdivision steps before the pieces are read off as B-splines.
-DEFAULT_LEVEL = 2
+DEFAULT_LEVEL = 3
 #: Spans whose limit samples deviate more than this fraction of the diagonal from the
 #: uniform B-spline are irregular (exact spans agree to rounding, about 1e-15).
 EXACT_TOL = 1e-10
@@ -264,6 +264,30 @@ def evaluate(piece: BSplinePiece, u, v, derivatives: bool = False):
     return pair(Bu, Bv), pair(Du, Bv), pair(Bu, Dv)
 
 
+def project(piece: BSplinePiece, points, u0, v0, iterations: int = 8):
+    """Closest points of a piece to ``points (k, 3)`` by Gauss-Newton from ``(u0, v0)``.
+
+    Parameters stay in the piece's domain (a point beyond a border projects onto it).
+
+    Returns
+    -------
+    u, v : (k,) float64
+    distance : (k,) float64
+    """
+    p = np.asarray(points, np.float64)
+    u, v = np.array(u0, np.float64), np.array(v0, np.float64)
+    hi_u, hi_v = piece.knots_u[-1], piece.knots_v[-1]
+    for _ in range(iterations):
+        S, Su, Sv = evaluate(piece, u, v, derivatives=True)
+        r = S - p
+        a, b, c = (Su * Su).sum(1), (Su * Sv).sum(1), (Sv * Sv).sum(1)
+        gu, gv = (Su * r).sum(1), (Sv * r).sum(1)
+        det = np.maximum(a * c - b * b, 1e-300)
+        u = np.clip(u - (c * gu - b * gv) / det, 0.0, hi_u)
+        v = np.clip(v - (a * gv - b * gu) / det, 0.0, hi_v)
+    return u, v, np.linalg.norm(evaluate(piece, u, v) - p, axis=1)
+
+
 class _Level:
     """One subdivision level: positions, quads and the lookups the outer ring needs."""
 
@@ -374,29 +398,53 @@ def _extended(lv: _Level, G: np.ndarray):
     return E, clean
 
 
-def _levels(net: ControlNet, level: int, extra: int):
-    """Subdivide ``level + extra`` times, tracking every piece's grid.
+def _level(net: ControlNet, level: int):
+    """Subdivide ``level`` times, tracking every piece's grid.
 
-    Returns ``(lv_k, grids_k, V_s, grids_s, L_s)``: the level-``level`` mesh with its
-    grids, and the sample level's positions, grids and limit matrix.
+    Returns ``(patches, lv, grids, limit, corners)``: patch of each piece, the
+    level's :class:`_Level`, the pieces' grids, the exact limit positions of the
+    level's vertices and its corner flags.
     """
     V, Q = np.asarray(net.vertices, np.float64), np.asarray(net.quads, np.int64)
     se = np.asarray(net.sharp_edges, np.int64).reshape(-1, 2)
     cr = np.asarray(net.corners, bool)
     pieces = piece_grids(Q, net.face_patch)
     grids = [G for _, G in pieces]
-    lv_k = grids_k = None
-    for step in range(level + extra + 1):
-        if step == level:
-            lv_k, grids_k = _Level(V, Q, se), list(grids)
-        if step == level + extra:
-            break
+    for _ in range(level):
         st = subdivision_step(Q, len(V), se, cr)
         find = _diag_lookup(Q, len(V))
         grids = [refine_grid(G, Q, st.topo, find) for G in grids]
         V, Q, se, cr = st.S @ V, st.quads, st.sharp_edges, st.corners
-    L = limit_matrix(Q, len(V), se, cr)
-    return [p for p, _ in pieces], lv_k, grids_k, L @ V, grids
+    lv = _Level(V, Q, se)
+    lv.sharp_edges, lv.corners = se, cr
+    return [p for p, _ in pieces], lv, grids, limit_matrix(Q, len(V), se, cr) @ V
+
+
+def _local_samples(lv: _Level, spans: list, levels: int) -> np.ndarray:
+    """Exact limit samples ``(len(spans), 2^levels + 1, 2^levels + 1, 3)`` over faces.
+
+    ``spans`` are 2 x 2 id grids of faces of ``lv``. Only those faces and the faces
+    around them are subdivided: the limit surface over a face depends on its one-ring
+    alone, so the submesh's own (sharp) border does not reach the samples.
+    """
+    H = np.stack(spans)                                          # (k, 2, 2)
+    bad_faces = lv.find(H[:, 0, 0], H[:, 1, 1])
+    near = np.zeros(lv.n, bool)
+    near[lv.Q[bad_faces].ravel()] = True
+    Q = lv.Q[near[lv.Q].any(axis=1)]
+    V, se, cr = lv.V, lv.sharp_edges, lv.corners
+    grids = list(H)
+    for _ in range(levels):
+        st = subdivision_step(Q, len(V), se, cr)
+        find = _diag_lookup(Q, len(V))
+        grids = [refine_grid(G, Q, st.topo, find) for G in grids]
+        V, Q, se, cr = st.S @ V, st.quads, st.sharp_edges, st.corners
+    ids = np.stack(grids)
+    used = np.unique(ids)
+    L = limit_matrix(Q, len(V), se, cr)[used]
+    lut = np.zeros(len(V), np.int64)
+    lut[used] = np.arange(len(used))
+    return (L @ V)[lut[ids]]
 
 
 def _spans_to_samples(spans: np.ndarray, r: int) -> np.ndarray:
@@ -442,7 +490,7 @@ def _fit_irregular(E, Bu, Bv, S, bad_span, r):
 
 
 def extract_bsplines(net: ControlNet, level: int = DEFAULT_LEVEL, *,
-                     sample_levels: int = 3) -> BSplineSet:
+                     sample_levels: int = 2) -> BSplineSet:
     """Bicubic B-spline pieces of the limit surface of ``net``, with a seam report.
 
     Parameters
@@ -467,26 +515,41 @@ def extract_bsplines(net: ControlNet, level: int = DEFAULT_LEVEL, *,
     if int(sample_levels) != sample_levels or sample_levels < 2:
         raise ValueError(f"sample_levels: expected an integer >= 2, got {sample_levels!r}")
     diag = net.diagonal if net.diagonal > 0 else 1.0
-    patches, lv, grids_k, Vs, grids_s = _levels(net, int(level), int(sample_levels))
+    patches, lv, grids, limit = _level(net, int(level))
     r = 2 ** int(sample_levels)
-    pieces, border = [], []
-    for pid, (patch, G, Gs) in enumerate(zip(patches, grids_k, grids_s)):
+    nets, bad_spans, todo = [], [], []
+    for G in grids:                    # uniform poles; irregular spans: corners off the limit
         M, N = G.shape[0] - 1, G.shape[1] - 1
         E, clean = _extended(lv, G)
+        at = _tensor(_design(np.arange(M + 1), M), E, _design(np.arange(N + 1), N))
+        off = np.linalg.norm(at - limit[G], axis=2) > EXACT_TOL * diag
+        bad = off[:-1, :-1] | off[1:, :-1] | off[:-1, 1:] | off[1:, 1:]
+        nets.append((E, clean))
+        bad_spans.append(bad)
+        todo += [G[i:i + 2, j:j + 2] for i, j in np.argwhere(bad)]
+    exact_samples = iter(_local_samples(lv, todo, int(sample_levels)) if todo else ())
+    pieces, border = [], []
+    for pid, (patch, G, (E, clean), bad) in enumerate(zip(patches, grids, nets, bad_spans)):
+        M, N = G.shape[0] - 1, G.shape[1] - 1
         u, v = np.arange(r * M + 1) / r, np.arange(r * N + 1) / r
         Bu, Bv = _design(u, M), _design(v, N)
-        S = Vs[Gs]
-        err = np.linalg.norm(_tensor(Bu, E, Bv) - S, axis=2)
-        bad = _span_max(err, M, N, r) > EXACT_TOL * diag
+        S = _tensor(Bu, E, Bv)            # exact on regular spans
+        for i, j in np.argwhere(bad):
+            S[i * r:(i + 1) * r + 1, j * r:(j + 1) * r + 1] = next(exact_samples)
         exact = not bad.any()
+        err = np.zeros(S.shape[:2])
         if not exact:
             E = _fit_irregular(E, Bu[::2], Bv[::2], S[::2, ::2], bad, r // 2)
             err = np.linalg.norm(_tensor(Bu, E, Bv) - S, axis=2)
         poles, ku = clamp_uniform(E, M, 0)
         poles, kv = clamp_uniform(poles, N, 1)
-        pieces.append(BSplinePiece(poles, ku, kv, int(patch), exact and clean,
-                                   float(err.max() / diag)))
-        border.append(_border_samples(pid, Gs, r, err / diag))
+        pc = BSplinePiece(poles, ku, kv, int(patch), exact and clean, 0.0)
+        if not exact:                    # distance to the surface, not to the same (u, v)
+            i, j = np.nonzero(_spans_to_samples(bad, r))
+            err[i, j] = np.minimum(err[i, j], project(pc, S[i, j], u[i], v[j])[2])
+        pc.deviation = float(err.max() / diag)
+        pieces.append(pc)
+        border.append(_border_samples(pid, G, r, err / diag, lv.n))
     seams = _seams(pieces, border, net)
     dev = max((p.deviation for p in pieces), default=0.0)
     per_patch: dict = {}
@@ -506,11 +569,32 @@ def _span_max(err: np.ndarray, M: int, N: int, r: int) -> np.ndarray:
     return err[iu[:, :, None, None], iv[None, None, :, :]].max(axis=(1, 3))
 
 
-def _border_samples(pid: int, Gs: np.ndarray, r: int, err: np.ndarray):
-    """Sample-level vertex ids, parameters and errors along a piece's border."""
-    ii, jj = np.meshgrid(np.arange(Gs.shape[0]), np.arange(Gs.shape[1]), indexing="ij")
-    on = (ii == 0) | (jj == 0) | (ii == Gs.shape[0] - 1) | (jj == Gs.shape[1] - 1)
-    return (np.full(on.sum(), pid), Gs[on], ii[on] / r, jj[on] / r, err[on])
+def _border_samples(pid: int, G: np.ndarray, r: int, err: np.ndarray, n: int):
+    """Keys, parameters and errors of a piece's border samples.
+
+    A sample at fraction ``f / r`` of the level's border edge ``(a, b)`` has the key
+    ``(min, max, f)`` (``f`` counted from ``min``), a sample at a vertex ``(a, a, 0)``:
+    pieces sharing a border edge get equal keys for equal points.
+    """
+    M, N = G.shape[0] - 1, G.shape[1] - 1
+    out = []
+    along_u, along_v = np.arange(r * M + 1), np.arange(r * N + 1)
+    for line, ii, jj in ((G[:, 0], along_u, 0), (G[:, N], along_u, r * N),
+                       (G[0, :], 0, along_v), (G[M, :], r * M, along_v)):
+        t = np.arange(r * (len(line) - 1) + 1)
+        k, f = t // r, t % r
+        a, b = line[k], line[np.minimum(k + 1, len(line) - 1)]
+        lo, hi = np.minimum(a, b), np.maximum(a, b)
+        f = np.where(a == lo, f, r - f)
+        vert = np.where(f == 0, lo, hi)
+        key = np.where((f == 0) | (f == r), vert * (n * r + r) + vert * r,
+                       lo * (n * r + r) + hi * r + f)
+        ii, jj = np.broadcast_arrays(ii, jj)
+        out.append((key, ii, jj))
+    key, ii, jj = (np.concatenate(x) for x in zip(*out))
+    key, first = np.unique(key, return_index=True)
+    ii, jj = ii[first], jj[first]
+    return (np.full(len(key), pid), key, ii / r, jj / r, err[ii, jj])
 
 
 def _normals(piece: BSplinePiece, u, v):
@@ -529,6 +613,7 @@ def _seams(pieces: list, border: list, net: ControlNet) -> list:
         P[m], Nrm[m] = _normals(piece, u[m], v[m])
     order = np.lexsort((pid, vid))
     pid, vid, P, Nrm, err = pid[order], vid[order], P[order], Nrm[order], err[order]
+    u, v = u[order], v[order]
     starts = np.flatnonzero(np.r_[True, vid[1:] != vid[:-1]])
     counts = np.diff(np.r_[starts, len(vid)])
     pairs = []                                           # (entry i, entry j)
@@ -541,7 +626,13 @@ def _seams(pieces: list, border: list, net: ControlNet) -> list:
         return []
     pr = np.concatenate(pairs)
     pr = pr[pid[pr[:, 0]] != pid[pr[:, 1]]]
-    gap = np.linalg.norm(P[pr[:, 0]] - P[pr[:, 1]], axis=1) / max(net.diagonal, 1e-300)
+    gap = np.linalg.norm(P[pr[:, 0]] - P[pr[:, 1]], axis=1)
+    far = np.flatnonzero(gap > EXACT_TOL * net.diagonal)   # geometric gap: onto the other
+    for k in np.unique(pid[pr[far, 1]]):
+        f = far[pid[pr[far, 1]] == k]
+        j = pr[f, 1]
+        gap[f] = np.minimum(gap[f], project(pieces[k], P[pr[f, 0]], u[j], v[j])[2])
+    gap /= max(net.diagonal, 1e-300)
     cos = np.einsum("ij,ij->i", Nrm[pr[:, 0]], Nrm[pr[:, 1]])
     ang = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
     dev = np.maximum(err[pr[:, 0]], err[pr[:, 1]])

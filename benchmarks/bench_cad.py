@@ -1,0 +1,95 @@
+"""Benchmark of the CAD output (issue 21): B-spline faces in STEP, read back and checked.
+
+For every analytic shape of ``curvenet.shapes`` and every public network in
+``$CURVENET_DATA/networks`` (default ``../shared/data``): surface it on the classical
+route, export STEP, read it back with OpenCascade and print
+
+* patches, B-spline faces (pieces) and how many are exact;
+* validity (``BRepCheck_Analyzer``), free edges of the read-back shape against the
+  network's open-boundary curves (curves used by one patch), solids;
+* the largest deviation of the B-spline faces from the limit surface (fraction of the
+  diagonal; exact limit points one level finer than the fit), the largest seam gap
+  (G0) and the largest normal angle across non-crease seams (G1, degrees);
+* export seconds (B-spline extraction + sewing + writing).
+
+Then the export time of a 100-patch network (a 10 x 10 saddle grid; target < 10 s).
+
+Run: ``python benchmarks/bench_cad.py [--quick]`` (needs ``pip install 'curvenet[cad]'``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from curvenet import cad, shapes  # noqa: E402
+from curvenet.errors import CurvenetError  # noqa: E402
+from curvenet.pipeline import surface  # noqa: E402
+
+HEADER = (f"{'input':<28s} {'patches':>7s} {'faces':>5s} {'exact':>5s} {'valid':>5s} "
+          f"{'free':>5s} {'open':>5s} {'solid':>5s} {'deviation':>9s} {'gap':>8s} "
+          f"{'G1 deg':>7s} {'export s':>8s}")
+
+
+def _open_curves(res) -> int:
+    uses = np.zeros(len(res.network.edges), int)
+    for p in res.patchset.patches:
+        for e in p.edges:
+            uses[e] += 1
+    return int((uses == 1).sum())
+
+
+def run_one(name, source, tmp) -> str:
+    try:
+        res = surface(source, method="classical", subdiv=1)
+    except CurvenetError as err:
+        return f"{name:<28s} not surfaced: {err}"
+    path = Path(tmp, "out.step")
+    t = time.perf_counter()
+    res.save(path)
+    dt = time.perf_counter() - t
+    rep = res.diagnostics["cad"]
+    back = cad.shape_report(cad.read_step(path))
+    pr, seams = rep["pieces"], rep["seams"]
+    smooth = [s["angle"] for s in seams if not s["crease"]]
+    gap = max((s["gap"] for s in seams), default=0.0)
+    return (f"{name:<28s} {len(res.patchset.patches):>7d} {back['faces']:>5d} "
+            f"{pr['n_exact']:>5d} {str(back['valid']):>5s} {back['free_edges']:>5d} "
+            f"{_open_curves(res):>5d} {back['solids']:>5d} {pr['max_deviation']:>9.1e} "
+            f"{gap:>8.1e} {max(smooth, default=0.0):>7.2f} {dt:>8.2f}")
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="analytic shapes and 100 patches only")
+    args = ap.parse_args(argv)
+    root = Path(os.environ.get("CURVENET_DATA", Path(__file__).resolve().parents[2] /
+                               "shared" / "data")) / "networks"
+    inputs = [(f"shapes.{f.__name__}", f().sketch()) for f in (
+        shapes.box, shapes.l_prism, shapes.house, shapes.two_boxes, shapes.grid_box,
+        shapes.grid_sheet, shapes.saddle_grid, shapes.latlong_sphere, shapes.ellipsoid,
+        shapes.capped_cylinder, shapes.torus)]
+    if not args.quick and root.is_dir():
+        inputs += [(f"{p.parent.name}/{p.name}", p) for p in sorted(root.glob("*/*.obj"))]
+    print(HEADER)
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, src in inputs:
+            print(run_one(name, src, tmp), flush=True)
+        res = surface(shapes.saddle_grid(10).sketch(), method="classical", subdiv=1)
+        t = time.perf_counter()
+        res.save(Path(tmp, "grid100.step"))
+        print(f"\n100-patch export (saddle_grid(10), {len(res.patchset.patches)} patches): "
+              f"{time.perf_counter() - t:.2f} s")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
