@@ -24,6 +24,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.sparse as sp
 from scipy.interpolate import BSpline
 
 from .catmull_clark import _sharp_mask, edge_index, edge_topology, subdivision_step
@@ -249,19 +250,29 @@ def evaluate(piece: BSplinePiece, u, v, derivatives: bool = False):
     """
     u, v = np.asarray(u, np.float64), np.asarray(v, np.float64)
     nu, nv = len(piece.knots_u) - 4, len(piece.knots_v) - 4
-
-    def basis(x, t, n, d):
-        c = np.eye(n)
-        return BSpline(t, c, 3)(x, nu=d)                     # (k, n)
-    Bu, Bv = basis(u, piece.knots_u, nu, 0), basis(v, piece.knots_v, nv, 0)
     flat = piece.poles.reshape(nu, -1)
 
-    def pair(A, B):
-        return ((A @ flat).reshape(len(u), nv, 3) * B[:, :, None]).sum(1)
+    def pair(A, B):                       # sparse (k, nu) basis in u, dense (k, nv) in v
+        return (np.asarray(A @ flat).reshape(len(u), nv, 3) * B.toarray()[:, :, None]).sum(1)
+    Bu, Bv = _basis(u, piece.knots_u, 0), _basis(v, piece.knots_v, 0)
     if not derivatives:
         return pair(Bu, Bv)
-    Du, Dv = basis(u, piece.knots_u, nu, 1), basis(v, piece.knots_v, nv, 1)
+    Du, Dv = _basis(u, piece.knots_u, 1), _basis(v, piece.knots_v, 1)
     return pair(Bu, Bv), pair(Du, Bv), pair(Bu, Dv)
+
+
+def _basis(x: np.ndarray, t: np.ndarray, derivative: int):
+    """Sparse cubic B-spline basis ``(k, len(t) - 4)`` at ``x``, or its first derivative.
+
+    The derivative of a cubic with poles ``c`` is the quadratic on ``t[1:-1]`` with
+    poles ``3 (c[i + 1] - c[i]) / (t[i + 4] - t[i + 1])``.
+    """
+    if derivative == 0:
+        return BSpline.design_matrix(x, t, 3)
+    n = len(t) - 4
+    w = 3.0 / (t[4:n + 3] - t[1:n])
+    D = sp.diags([-w, w], [0, 1], shape=(n - 1, n))
+    return BSpline.design_matrix(x, t[1:-1], 2) @ D
 
 
 def project(piece: BSplinePiece, points, u0, v0, iterations: int = 8):
@@ -531,14 +542,14 @@ def extract_bsplines(net: ControlNet, level: int = DEFAULT_LEVEL, *,
     pieces, border = [], []
     for pid, (patch, G, (E, clean), bad) in enumerate(zip(patches, grids, nets, bad_spans)):
         M, N = G.shape[0] - 1, G.shape[1] - 1
-        u, v = np.arange(r * M + 1) / r, np.arange(r * N + 1) / r
-        Bu, Bv = _design(u, M), _design(v, N)
-        S = _tensor(Bu, E, Bv)            # exact on regular spans
-        for i, j in np.argwhere(bad):
-            S[i * r:(i + 1) * r + 1, j * r:(j + 1) * r + 1] = next(exact_samples)
         exact = not bad.any()
-        err = np.zeros(S.shape[:2])
+        err = np.zeros((r * M + 1, r * N + 1))
         if not exact:
+            u, v = np.arange(r * M + 1) / r, np.arange(r * N + 1) / r
+            Bu, Bv = _design(u, M), _design(v, N)
+            S = _tensor(Bu, E, Bv)            # exact on regular spans
+            for i, j in np.argwhere(bad):
+                S[i * r:(i + 1) * r + 1, j * r:(j + 1) * r + 1] = next(exact_samples)
             E = _fit_irregular(E, Bu[::2], Bv[::2], S[::2, ::2], bad, r // 2)
             err = np.linalg.norm(_tensor(Bu, E, Bv) - S, axis=2)
         poles, ku = clamp_uniform(E, M, 0)
