@@ -6,8 +6,9 @@ control mesh is regular, fitted and measured near irregular vertices). This modu
 only turns those pieces into files:
 
 * STEP (AP214 or AP242): one ``B_SPLINE_SURFACE`` face per piece, faces sewn with
-  ``BRepBuilderAPI_Sewing`` so pieces meeting along a curve share that edge; each
-  closed shell becomes a solid.
+  ``BRepBuilderAPI_Sewing`` so pieces meeting along a curve share that edge, one
+  shell per manifold piece (curves bordering three or more patches separate them);
+  each closed shell becomes a solid.
 * 3DM: one NURBS surface per piece (rhino3dm has no sewing; Rhino joins them with
   ``Join``).
 
@@ -24,7 +25,7 @@ from ._atomic import atomic_path
 from .errors import InvalidParameterError, MissingDependencyError
 
 __all__ = ["CAD_FORMATS", "STEP_SCHEMAS", "write_cad", "write_step", "write_3dm", "read_step",
-           "occ_faces", "sew", "shape_report", "require_cad"]
+           "occ_faces", "sew", "manifold_groups", "shape_report", "require_cad"]
 
 CAD_FORMATS = (".step", ".stp", ".3dm")
 #: STEP application protocols and the names OpenCascade's writer knows them by.
@@ -79,15 +80,52 @@ def occ_faces(pieces: list) -> list:
     return faces
 
 
-def sew(faces: list, tolerance: float):
-    """Sew faces into shells; closed shells become solids.
+def manifold_groups(n_pieces: int, seams: list) -> list:
+    """Pieces joined across manifold seams: one group per manifold piece of the surface.
+
+    A seam is manifold when each network curve along it borders exactly two pieces;
+    curves shared by three or more pieces (a wall between two cells) separate groups.
 
     Returns
     -------
-    shape : TopoDS_Shape
-        A compound of the solids and the open shells.
+    list of (k,) int64
+    """
+    uses: dict = {}
+    for s in seams:
+        for c in s["curves"]:
+            uses.setdefault(c, set()).update(s["pieces"])
+    parent = np.arange(n_pieces)
+
+    def root(i):
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+    for s in seams:
+        if all(len(uses[c]) == 2 for c in s["curves"]):
+            a, b = (root(i) for i in s["pieces"])
+            parent[a] = b
+    roots = np.array([root(i) for i in range(n_pieces)])
+    return [np.flatnonzero(roots == r) for r in np.unique(roots)]
+
+
+def sew(faces: list, tolerance: float, groups=None):
+    """Sew faces into shells, one sewing per group; closed shells become solids.
+
+    Parameters
+    ----------
+    faces : list of TopoDS_Face
+    tolerance : float
+        Model units.
+    groups : list of index arrays, optional
+        Faces sewn together (:func:`manifold_groups`); default all.
+
+    Returns
+    -------
+    shape : TopoDS_Compound
+        The solids and the open shells.
     free_edges : int
-        Edges of the sewn result used by one face only.
+        Edges used by one face only, summed over the groups.
     """
     from OCP.BRep import BRep_Builder
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
@@ -95,27 +133,28 @@ def sew(faces: list, tolerance: float):
     from OCP.TopExp import TopExp_Explorer
     from OCP.TopoDS import TopoDS, TopoDS_Compound
 
-    sw = BRepBuilderAPI_Sewing(tolerance)
-    for f in faces:
-        sw.Add(f)
-    sw.Perform()
-    sewn = sw.SewedShape()
     comp = TopoDS_Compound()
     bld = BRep_Builder()
     bld.MakeCompound(comp)
-    exp = TopExp_Explorer(sewn, TopAbs_SHELL)
-    n_shell = 0
-    while exp.More():
-        shell = TopoDS.Shell(exp.Current())
-        n_shell += 1
-        if _free_edges(shell) == 0:
-            bld.Add(comp, BRepBuilderAPI_MakeSolid(shell).Solid())
-        else:
-            bld.Add(comp, shell)
-        exp.Next()
-    if n_shell == 0:                     # a single face: sewing returns the face itself
-        bld.Add(comp, sewn)
-    return comp, int(sw.NbFreeEdges())
+    free = 0
+    for group in groups if groups is not None else [range(len(faces))]:
+        sw = BRepBuilderAPI_Sewing(tolerance)
+        for i in group:
+            sw.Add(faces[i])
+        sw.Perform()
+        sewn = sw.SewedShape()
+        free += int(sw.NbFreeEdges())
+        exp = TopExp_Explorer(sewn, TopAbs_SHELL)
+        if not exp.More():               # a single face: sewing returns the face itself
+            bld.Add(comp, sewn)
+        while exp.More():
+            shell = TopoDS.Shell(exp.Current())
+            if _free_edges(shell) == 0:
+                bld.Add(comp, BRepBuilderAPI_MakeSolid(shell).Solid())
+            else:
+                bld.Add(comp, shell)
+            exp.Next()
+    return comp, free
 
 
 def _count(shape, kind) -> int:
@@ -169,7 +208,8 @@ def write_step(path, bset, *, schema: str = "AP214") -> dict:
     diag = bset.report.get("diagonal", 1.0)
     gap = max((s["gap"] for s in bset.seams), default=0.0)
     tol = max(SEW_TOL, 2.0 * gap) * diag
-    shape, free = sew(occ_faces(bset.pieces), tol)
+    groups = manifold_groups(len(bset.pieces), bset.seams)
+    shape, free = sew(occ_faces(bset.pieces), tol, groups)
     STEPControl_Controller.Init_s()              # registers the parameter the schema sets
     Interface_Static.SetCVal_s("write.step.schema", STEP_SCHEMAS[schema])
     writer = STEPControl_Writer()
@@ -179,7 +219,8 @@ def write_step(path, bset, *, schema: str = "AP214") -> dict:
         if writer.Write(str(tmp)) != IFSelect_RetDone:
             raise OSError(f"{path}: the STEP writer failed")
     rep = shape_report(shape)
-    rep.update(sew_tolerance=float(tol), sewing_free_edges=free, schema=schema)
+    rep.update(sew_tolerance=float(tol), sewing_free_edges=free, schema=schema,
+               manifold_pieces=len(groups))
     return rep
 
 
