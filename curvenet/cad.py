@@ -83,17 +83,14 @@ def occ_faces(pieces: list) -> list:
 def manifold_groups(n_pieces: int, seams: list) -> list:
     """Pieces joined across manifold seams: one group per manifold piece of the surface.
 
-    A seam is manifold when each network curve along it borders exactly two pieces;
-    curves shared by three or more pieces (a wall between two cells) separate groups.
+    A seam is manifold when no third piece borders it (its ``manifold`` flag of
+    :func:`curvenet.surfacing.bspline.extract_bsplines`); a curve shared by three or
+    more patches (a wall between two cells) separates groups.
 
     Returns
     -------
     list of (k,) int64
     """
-    uses: dict = {}
-    for s in seams:
-        for c in s["curves"]:
-            uses.setdefault(c, set()).update(s["pieces"])
     parent = np.arange(n_pieces)
 
     def root(i):
@@ -102,7 +99,7 @@ def manifold_groups(n_pieces: int, seams: list) -> list:
             i = parent[i]
         return i
     for s in seams:
-        if all(len(uses[c]) == 2 for c in s["curves"]):
+        if s["manifold"]:
             a, b = (root(i) for i in s["pieces"])
             parent[a] = b
     roots = np.array([root(i) for i in range(n_pieces)])

@@ -103,8 +103,12 @@ class BSplineSet:
     pieces : list of BSplinePiece
     seams : list of dict
         One per pair of pieces sharing a border: ``pieces``, ``patches``, ``curves``
-        (network curves along it), ``crease``, ``gap`` (G0, fraction of the
-        diagonal), ``angle`` (G1, degrees), ``deviation``.
+        (network curves along it), ``crease``, ``manifold`` (no other piece borders
+        it), ``flipped`` (the two faces are oriented oppositely; ``angle`` is then
+        taken between one normal and the other's opposite), ``gap`` (G0, largest
+        distance of one border to the other face, fraction of the diagonal),
+        ``angle`` (G1, largest normal angle, degrees), ``deviation`` (largest
+        distance of exact limit points along it to the faces).
     report : dict
         ``level``, ``sample_levels``, ``diagonal`` (model units), ``n_pieces``,
         ``n_exact``, ``max_deviation``, ``pieces_per_patch`` (patches of more than one
@@ -651,15 +655,22 @@ def _seams(pieces: list, border: list, net: ControlNet) -> list:
     uk, inv, cnt = np.unique(key, axis=0, return_inverse=True, return_counts=True)
     inv = inv.ravel()
     curves, sharp = _piece_curves(net)
+    n_sides: dict = {}                                 # pieces bordering each level-0 edge
+    for c in curves:
+        for e in c:
+            n_sides[e] = n_sides.get(e, 0) + 1
     out = []
     for g in np.flatnonzero(cnt > 1):                  # a shared point is not a seam
         m = inv == g
         a, b = (int(x) for x in uk[g])
         shared = curves[a].keys() & curves[b].keys()
+        flipped = bool(cos[m].mean() < 0)              # loops of opposite orientation
         out.append({"pieces": [a, b], "patches": [pieces[a].patch, pieces[b].patch],
                     "curves": sorted({curves[a][e] for e in shared} - {-1}),
                     "crease": bool(shared) and all(e in sharp for e in shared),
-                    "gap": float(gap[m].max()), "angle": float(ang[m].max()),
+                    "manifold": all(n_sides[e] == 2 for e in shared), "flipped": flipped,
+                    "gap": float(gap[m].max()),
+                    "angle": float((180.0 - ang[m] if flipped else ang[m]).max()),
                     "deviation": float(dev[m].max())})
     return out
 
