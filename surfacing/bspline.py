@@ -27,7 +27,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.interpolate import BSpline
 
-from .catmull_clark import _sharp_mask, edge_index, edge_topology, subdivision_step
+from .catmull_clark import edge_index, edge_topology, sharp_mask, subdivision_step
 from .limit import limit_matrix
 
 __all__ = ["ControlNet", "BSplinePiece", "BSplineSet", "piece_grids", "refine_grid",
@@ -310,7 +310,7 @@ class _Level:
         self.V, self.Q = V, Q
         n = self.n = len(V)
         self.topo = edge_topology(Q, n)
-        self.sharp = _sharp_mask(self.topo, sharp_edges)
+        self.sharp = sharp_mask(self.topo, sharp_edges)
         self.find = _diag_lookup(Q, n)
         a, b = Q.ravel(), np.roll(Q, -1, axis=1).ravel()
         keys = np.minimum(a, b) * n + np.maximum(a, b)
