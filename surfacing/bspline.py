@@ -103,7 +103,8 @@ class BSplineSet:
     pieces : list of BSplinePiece
     seams : list of dict
         One per pair of pieces sharing a border: ``pieces``, ``patches``, ``curves``
-        (network curves along it), ``crease``, ``manifold`` (no other piece borders
+        (network curves along it), ``crease`` (sharp: a crease, or a curve of three
+        or more patches), ``manifold`` (no other piece borders
         it), ``flipped`` (the two faces are oriented oppositely; ``angle`` is then
         taken between one normal and the other's opposite), ``gap`` (G0, largest
         distance of one border to the other face, fraction of the diagonal),
@@ -169,18 +170,26 @@ def _grid_quads(G):
 
 
 def _diag_lookup(quads: np.ndarray, n: int):
-    """Face of a quad given one diagonal: ``find(a, c) -> face or -1``."""
+    """Face of a quad given a diagonal ``(a, c)`` and, where two quads share that
+    diagonal (two patches on the same loop), a third vertex ``b``:
+    ``find(a, c, b=None) -> face or -1``."""
     k02 = np.minimum(quads[:, 0], quads[:, 2]) * n + np.maximum(quads[:, 0], quads[:, 2])
     k13 = np.minimum(quads[:, 1], quads[:, 3]) * n + np.maximum(quads[:, 1], quads[:, 3])
     keys = np.concatenate([k02, k13])
     face = np.tile(np.arange(len(quads)), 2)
-    order = np.argsort(keys)
+    order = np.argsort(keys, kind="stable")
     keys, face = keys[order], face[order]
+    last = len(keys) - 1
 
-    def find(a, c):
+    def find(a, c, b=None):
         k = np.minimum(a, c) * n + np.maximum(a, c)
-        pos = np.clip(np.searchsorted(keys, k), 0, len(keys) - 1)
-        return np.where(keys[pos] == k, face[pos], -1)
+        pos = np.clip(np.searchsorted(keys, k), 0, last)
+        f = np.where(keys[pos] == k, face[pos], -1)
+        if b is not None:
+            nxt = np.minimum(pos + 1, last)
+            alt = (keys[nxt] == k) & (nxt != pos) & ~(quads[f] == np.asarray(b)[..., None]).any(-1)
+            f = np.where(alt, face[nxt], f)
+        return f
     return find
 
 
@@ -208,7 +217,8 @@ def refine_grid(G: np.ndarray, quads: np.ndarray, topo, find=None) -> np.ndarray
     H[0::2, 0::2] = G
     H[1::2, 0::2] = n + edge_index(topo, G[:-1].ravel(), G[1:].ravel()).reshape(p, q + 1)
     H[0::2, 1::2] = n + edge_index(topo, G[:, :-1].ravel(), G[:, 1:].ravel()).reshape(p + 1, q)
-    H[1::2, 1::2] = n + ne + find(G[:-1, :-1].ravel(), G[1:, 1:].ravel()).reshape(p, q)
+    H[1::2, 1::2] = n + ne + find(G[:-1, :-1].ravel(), G[1:, 1:].ravel(),
+                                  G[1:, :-1].ravel()).reshape(p, q)
     return H
 
 
@@ -344,7 +354,7 @@ def _side(lv: _Level, Gs: np.ndarray):
     """
     V = lv.V
     a, b = Gs[:-1, 0], Gs[1:, 0]
-    own = lv.find(a, Gs[1:, 1])
+    own = lv.find(a, Gs[1:, 1], b)
     oa, ob, sharp = lv.across(a, b, own)
     ghost = 2.0 * V[Gs[:, 0]] - V[Gs[:, 1]]
     m = len(a)
@@ -399,9 +409,8 @@ def _extended(lv: _Level, G: np.ndarray):
         if s_i:                                  # column i = -1 is phantom
             Ev[0, 0] = 2.0 * Ev[1, 0] - Ev[2, 0]
             continue
-        x, y = Iv[0, 1], Iv[1, 0]
-        f = lv.find(np.array([x]), np.array([y]))[0] if min(x, y) >= 0 else -1
-        c = Gv[0, 0]
+        x, y, c = Iv[0, 1], Iv[1, 0], Gv[0, 0]
+        f = lv.find(np.array([x]), np.array([y]), np.array([c]))[0] if min(x, y) >= 0 else -1
         if f >= 0 and c in lv.Q[f]:
             q = lv.Q[f]
             k = int(np.flatnonzero(q == c)[0])
@@ -443,7 +452,7 @@ def _local_samples(lv: _Level, spans: list, levels: int) -> np.ndarray:
     alone, so the submesh's own (sharp) border does not reach the samples.
     """
     H = np.stack(spans)                                          # (k, 2, 2)
-    bad_faces = lv.find(H[:, 0, 0], H[:, 1, 1])
+    bad_faces = lv.find(H[:, 0, 0], H[:, 1, 1], H[:, 1, 0])
     near = np.zeros(lv.n, bool)
     near[lv.Q[bad_faces].ravel()] = True
     Q = lv.Q[near[lv.Q].any(axis=1)]
@@ -463,7 +472,7 @@ def _local_samples(lv: _Level, spans: list, levels: int) -> np.ndarray:
 
 
 def _spans_to_samples(spans: np.ndarray, r: int) -> np.ndarray:
-    """Samples ``((r M + 1) x (r N + 1))`` in the closure of the marked spans ``(M, N)``."""
+    """Samples ``(r M + 1, r N + 1)`` in the closure of the marked spans ``(M, N)``."""
     M, N = spans.shape
     out = np.zeros((r * M + 1, r * N + 1), bool)
     for du in range(r + 1):
@@ -525,6 +534,7 @@ def extract_bsplines(net: ControlNet, level: int = DEFAULT_LEVEL, *,
     -------
     BSplineSet
     """
+    from .seams import border_samples, seam_report    # imports this module
     if int(level) != level or level < 0:
         raise ValueError(f"level: expected an integer >= 0, got {level!r}")
     if int(sample_levels) != sample_levels or sample_levels < 2:
@@ -564,8 +574,8 @@ def extract_bsplines(net: ControlNet, level: int = DEFAULT_LEVEL, *,
             err[i, j] = np.minimum(err[i, j], project(pc, S[i, j], u[i], v[j])[2])
         pc.deviation = float(err.max() / diag)
         pieces.append(pc)
-        border.append(_border_samples(pid, G, r, err / diag, lv.n))
-    seams = _seams(pieces, border, net)
+        border.append(border_samples(pid, G, r, err / diag, lv.n))
+    seams = seam_report(pieces, border, net)
     dev = max((p.deviation for p in pieces), default=0.0)
     per_patch: dict = {}
     for p in pieces:
@@ -582,113 +592,3 @@ def _span_max(err: np.ndarray, M: int, N: int, r: int) -> np.ndarray:
     iu = np.arange(M)[:, None] * r + np.arange(r + 1)[None, :]      # (M, r + 1)
     iv = np.arange(N)[:, None] * r + np.arange(r + 1)[None, :]
     return err[iu[:, :, None, None], iv[None, None, :, :]].max(axis=(1, 3))
-
-
-def _border_samples(pid: int, G: np.ndarray, r: int, err: np.ndarray, n: int):
-    """Keys, parameters and errors of a piece's border samples.
-
-    A sample at fraction ``f / r`` of the level's border edge ``(a, b)`` has the key
-    ``(min, max, f)`` (``f`` counted from ``min``), a sample at a vertex ``(a, a, 0)``:
-    pieces sharing a border edge get equal keys for equal points.
-    """
-    M, N = G.shape[0] - 1, G.shape[1] - 1
-    out = []
-    along_u, along_v = np.arange(r * M + 1), np.arange(r * N + 1)
-    for line, ii, jj in ((G[:, 0], along_u, 0), (G[:, N], along_u, r * N),
-                       (G[0, :], 0, along_v), (G[M, :], r * M, along_v)):
-        t = np.arange(r * (len(line) - 1) + 1)
-        k, f = t // r, t % r
-        a, b = line[k], line[np.minimum(k + 1, len(line) - 1)]
-        lo, hi = np.minimum(a, b), np.maximum(a, b)
-        f = np.where(a == lo, f, r - f)
-        vert = np.where(f == 0, lo, hi)
-        key = np.where((f == 0) | (f == r), vert * (n * r + r) + vert * r,
-                       lo * (n * r + r) + hi * r + f)
-        ii, jj = np.broadcast_arrays(ii, jj)
-        out.append((key, ii, jj))
-    key, ii, jj = (np.concatenate(x) for x in zip(*out))
-    key, first = np.unique(key, return_index=True)
-    ii, jj = ii[first], jj[first]
-    return (np.full(len(key), pid), key, ii / r, jj / r, err[ii, jj])
-
-
-def _normals(piece: BSplinePiece, u, v):
-    P, du, dv = evaluate(piece, u, v, derivatives=True)
-    n = np.cross(du, dv)
-    return P, n / np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
-
-
-def _seams(pieces: list, border: list, net: ControlNet) -> list:
-    """Continuity report of every pair of pieces sharing at least one border segment."""
-    pid, vid, u, v, err = (np.concatenate(x) for x in zip(*border))
-    P = np.empty((len(pid), 3))
-    Nrm = np.empty((len(pid), 3))
-    for k, piece in enumerate(pieces):
-        m = pid == k
-        P[m], Nrm[m] = _normals(piece, u[m], v[m])
-    order = np.lexsort((pid, vid))
-    pid, vid, P, Nrm, err = pid[order], vid[order], P[order], Nrm[order], err[order]
-    u, v = u[order], v[order]
-    starts = np.flatnonzero(np.r_[True, vid[1:] != vid[:-1]])
-    counts = np.diff(np.r_[starts, len(vid)])
-    pairs = []                                           # (entry i, entry j)
-    for c in np.unique(counts[counts > 1]):
-        s = starts[counts == c]
-        for x in range(c):
-            for y in range(x + 1, c):
-                pairs.append(np.stack([s + x, s + y], 1))
-    if not pairs:
-        return []
-    pr = np.concatenate(pairs)
-    pr = pr[pid[pr[:, 0]] != pid[pr[:, 1]]]
-    gap = np.linalg.norm(P[pr[:, 0]] - P[pr[:, 1]], axis=1)
-    far = np.flatnonzero(gap > EXACT_TOL * net.diagonal)   # geometric gap: onto the other
-    for k in np.unique(pid[pr[far, 1]]):
-        f = far[pid[pr[far, 1]] == k]
-        j = pr[f, 1]
-        gap[f] = np.minimum(gap[f], project(pieces[k], P[pr[f, 0]], u[j], v[j])[2])
-    gap /= max(net.diagonal, 1e-300)
-    cos = np.einsum("ij,ij->i", Nrm[pr[:, 0]], Nrm[pr[:, 1]])
-    ang = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))
-    dev = np.maximum(err[pr[:, 0]], err[pr[:, 1]])
-    key = np.sort(np.stack([pid[pr[:, 0]], pid[pr[:, 1]]], 1), axis=1)
-    uk, inv, cnt = np.unique(key, axis=0, return_inverse=True, return_counts=True)
-    inv = inv.ravel()
-    curves, sharp = _piece_curves(net)
-    n_sides: dict = {}                                 # pieces bordering each level-0 edge
-    for c in curves:
-        for e in c:
-            n_sides[e] = n_sides.get(e, 0) + 1
-    out = []
-    for g in np.flatnonzero(cnt > 1):                  # a shared point is not a seam
-        m = inv == g
-        a, b = (int(x) for x in uk[g])
-        shared = curves[a].keys() & curves[b].keys()
-        flipped = bool(cos[m].mean() < 0)              # loops of opposite orientation
-        out.append({"pieces": [a, b], "patches": [pieces[a].patch, pieces[b].patch],
-                    "curves": sorted({curves[a][e] for e in shared} - {-1}),
-                    "crease": bool(shared) and all(e in sharp for e in shared),
-                    "manifold": all(n_sides[e] == 2 for e in shared), "flipped": flipped,
-                    "gap": float(gap[m].max()),
-                    "angle": float((180.0 - ang[m] if flipped else ang[m]).max()),
-                    "deviation": float(dev[m].max())})
-    return out
-
-
-def _piece_curves(net: ControlNet):
-    """Per piece: {level-0 border edge key: curve index or -1}; and the sharp keys."""
-    n = len(net.vertices)
-    edge_curve = {}
-    for c, ids in enumerate(net.curve_vids):
-        ids = np.asarray(ids, np.int64)
-        for k in (np.minimum(ids[:-1], ids[1:]) * n + np.maximum(ids[:-1], ids[1:])).tolist():
-            edge_curve[k] = c
-    se = np.asarray(net.sharp_edges, np.int64).reshape(-1, 2)
-    sharp = set((se.min(1) * n + se.max(1)).tolist())
-    out = []
-    for _, G in piece_grids(net.quads, net.face_patch):
-        ring = np.r_[G[:, 0], G[-1, 1:], G[-2::-1, -1], G[0, -2::-1]]
-        a, b = ring[:-1], ring[1:]
-        keys = (np.minimum(a, b) * n + np.maximum(a, b)).tolist()
-        out.append({k: edge_curve.get(k, -1) for k in keys})
-    return out, sharp
