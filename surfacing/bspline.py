@@ -11,10 +11,12 @@ edges the phantom row ``2 P_0 - P_1`` reproduces the crease rules, DeRose et al.
 piece's own control points plus the ring of vertices just outside it.
 
 Near irregular vertices (extraordinary valence, darts, T-junctions) the limit
-surface is not polynomial. There the poles whose support lies inside the
-irregular spans are fitted by least squares to exact limit points (limit
-positions of a finer level), and the remaining deviation is measured, not
-assumed. Everything else is exact to rounding.
+surface is not polynomial. Spans whose corners miss the exact limit positions are
+irregular; the poles acting on them are fitted by least squares to exact limit
+points over their support (the irregular spans' one-ring subdivided further, see
+:func:`_local_samples`), and the remaining deviation is measured as the distance of
+finer exact limit points to the surface, not assumed. Everything else is exact to
+rounding. The continuity report per seam is :mod:`.seams`.
 
 Arrays in, arrays out: this module knows no graph and no CAD kernel.
 """
@@ -585,10 +587,3 @@ def extract_bsplines(net: ControlNet, level: int = DEFAULT_LEVEL, *,
               "max_deviation": float(dev),
               "pieces_per_patch": {int(k): int(c) for k, c in per_patch.items() if c > 1}}
     return BSplineSet(pieces, seams, report)
-
-
-def _span_max(err: np.ndarray, M: int, N: int, r: int) -> np.ndarray:
-    """Largest sample error over each span's closed ``(r + 1) x (r + 1)`` samples."""
-    iu = np.arange(M)[:, None] * r + np.arange(r + 1)[None, :]      # (M, r + 1)
-    iv = np.arange(N)[:, None] * r + np.arange(r + 1)[None, :]
-    return err[iu[:, :, None, None], iv[None, None, :, :]].max(axis=(1, 3))
