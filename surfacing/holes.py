@@ -331,4 +331,4 @@ def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: f
     new_curves = None if res.curves is None else res.curves[:n]
     return PatchMeshResult(V, res.faces, report, face_patch=face_patch, curves=new_curves,
                            control_vertices=res.control_vertices,
-                           control_quads=res.control_quads)
+                           control_quads=res.control_quads, control_net=res.control_net)
