@@ -28,12 +28,19 @@ from .sides import DEFAULT_STRAIGHT_ANGLE
 from .soap import soapfilm_mesh
 
 __all__ = ["PatchMeshResult", "surface_loops", "soapfilm_loops", "check_loops_options",
-           "DEFAULT_RESOLUTION", "DEFAULT_SUBDIV", "DEFAULT_TOL"]
+           "DEFAULT_RESOLUTION", "DEFAULT_SUBDIV", "DEFAULT_TOL",
+           "DEFAULT_EDGE_LENGTH", "DEFAULT_MAX_FACES", "density_subdiv"]
 
 #: Control-polygon segments per curve (the paper's user-set N).
 DEFAULT_RESOLUTION = 4
 #: Catmull-Clark levels of the output mesh.
 DEFAULT_SUBDIV = 3
+#: Default output edge length, fraction of the diagonal: sets the Catmull-Clark level
+#: when ``subdiv`` is not given.
+DEFAULT_EDGE_LENGTH = 0.005
+#: Most triangles the level chosen from ``edge_length`` may write (an explicit
+#: ``subdiv`` is bounded by :data:`MAX_OUTPUT_FACES` only).
+DEFAULT_MAX_FACES = 200_000
 #: Curve-interpolation tolerance of the iterative fit, fraction of the diagonal.
 DEFAULT_TOL = 1e-4
 
@@ -81,7 +88,8 @@ def _quads_to_tris(q: np.ndarray) -> np.ndarray:
 MAX_OUTPUT_FACES = 20_000_000
 
 
-def check_loops_options(*, resolution=DEFAULT_RESOLUTION, subdiv=DEFAULT_SUBDIV, fit="lsq",
+def check_loops_options(*, resolution=DEFAULT_RESOLUTION, subdiv=None,
+                        edge_length=DEFAULT_EDGE_LENGTH, fit="lsq",
                         straight_angle=DEFAULT_STRAIGHT_ANGLE, tol=DEFAULT_TOL, lam=LAMBDA,
                         curve_weight=None, fairness="variation", n_loops: int = 1,
                         **_other) -> None:
@@ -99,7 +107,9 @@ def check_loops_options(*, resolution=DEFAULT_RESOLUTION, subdiv=DEFAULT_SUBDIV,
     """
     checks = [
         ("fit", fit, lambda v: v in ("lsq", "iterative"), "'lsq' or 'iterative'"),
-        ("subdiv", subdiv, lambda v: _is_int(v) and v >= 0, "an integer >= 0"),
+        ("subdiv", subdiv, lambda v: v is None or _is_int(v) and v >= 0,
+         "an integer >= 0 or None"),
+        ("edge_length", edge_length, lambda v: v > 0, "> 0"),
         ("resolution", resolution, lambda v: _is_int(v) and v >= 2, "an integer >= 2"),
         ("fairness", fairness, lambda v: v in FAIRNESS, f"one of {FAIRNESS}"),
         ("tol", tol, lambda v: v > 0, "> 0"),
@@ -114,7 +124,41 @@ def check_loops_options(*, resolution=DEFAULT_RESOLUTION, subdiv=DEFAULT_SUBDIV,
             good = False
         if not good:
             raise InvalidParameterError(f"{name}: expected {expected}, got {value!r}")
-    _check_output_size(n_loops, resolution, int(subdiv))
+    _check_output_size(n_loops, resolution, 0 if subdiv is None else int(subdiv))
+
+
+def density_subdiv(vertices, quads, diagonal, edge_length=DEFAULT_EDGE_LENGTH,
+                   max_faces=DEFAULT_MAX_FACES) -> int:
+    """Catmull-Clark level giving output edges of about ``edge_length`` of the diagonal.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64
+        Control-mesh vertices.
+    quads : (q, 4) int64
+        Control quads.
+    diagonal : float
+        Bounding-box diagonal of the curves.
+    edge_length : float
+        Target edge length, fraction of ``diagonal``.
+    max_faces : int
+        The level is lowered until the output has at most this many triangles
+        (``2 * q * 4**level``); never below 0.
+
+    Returns
+    -------
+    int
+        The smallest level whose mean control edge, halved per level, is at most the
+        target, capped by ``max_faces``.
+    """
+    if len(quads) == 0:
+        return 0
+    q = np.asarray(quads)
+    mean = float(np.linalg.norm(vertices[q] - vertices[np.roll(q, -1, axis=1)], axis=2).mean())
+    target = edge_length * (diagonal if diagonal > 0 else 1.0)
+    want = int(np.ceil(np.log2(mean / target))) if mean > target else 0
+    cap = int(np.floor(np.log(max(max_faces / (2 * len(q)), 1.0)) / np.log(4)))
+    return max(0, min(want, cap))
 
 
 def _check_output_size(n_loops: int, resolution: int, subdiv: int) -> None:
@@ -138,7 +182,8 @@ def _is_int(value) -> bool:
 
 def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None =
                   DEFAULT_CREASE_ANGLE, resolution: int = DEFAULT_RESOLUTION,
-                  subdiv: int = DEFAULT_SUBDIV, fit: str = "lsq", update_curves=False,
+                  subdiv: int | None = None, edge_length: float = DEFAULT_EDGE_LENGTH,
+                  fit: str = "lsq", update_curves=False,
                   straight_angle: float = DEFAULT_STRAIGHT_ANGLE, tol: float = DEFAULT_TOL,
                   max_iter: int = 500, lam: float = LAMBDA, curve_weight: float | None = None,
                   fairness: str = "variation", vspring_step: float = VSPRING_STEP
@@ -158,8 +203,12 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
     resolution : int
         Control-polygon segments per curve piece (>= 2, odd rounded up to even); long
         or winding curves get several pieces (:func:`surfacing.controlmesh.curve_pieces`).
-    subdiv : int
-        Catmull-Clark levels for the output mesh (>= 0).
+    subdiv : int or None
+        Catmull-Clark levels for the output mesh (>= 0); None chooses the level from
+        ``edge_length`` (see :func:`density_subdiv`, at most :data:`DEFAULT_MAX_FACES`
+        triangles).
+    edge_length : float
+        Target output edge length, fraction of the diagonal, when ``subdiv`` is None.
     fit : {"lsq", "iterative"}
         Direct sparse least squares with exact interpolation of the curve samples
         (default), or the published iteration (Eq. 3 with V-spring, Eq. 4).
@@ -199,7 +248,8 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
     ----------
     Orbay & Kara 2011, Sec. 4.2, 4.3.1 (Eq. 1-2), 4.3.2 (Eq. 3-4), 4.3.3; Halstead et al. 1993.
     """
-    check_loops_options(resolution=resolution, subdiv=subdiv, fit=fit, tol=tol, lam=lam,
+    check_loops_options(resolution=resolution, subdiv=subdiv, edge_length=edge_length,
+                        fit=fit, tol=tol, lam=lam,
                         straight_angle=straight_angle, curve_weight=curve_weight,
                         fairness=fairness, n_loops=len(loops))
     update = _curve_selection(update_curves, len(curves))
@@ -208,6 +258,8 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
     P, iters, sample_dev = _fit_control_net(
         cm, sharp, fit=fit, fairness=fairness, curve_weight=curve_weight, lam=lam, tol=tol,
         max_iter=max_iter, vspring_step=vspring_step, timings=timings)
+    if subdiv is None:
+        subdiv = density_subdiv(cm.vertices, cm.quads, cm.diagonal, edge_length)
     V, faces, face_patch, chains = _limit_surface(P, cm, sharp, int(subdiv), timings)
     dev, new_curves = _curve_fit_report(V, chains, curves, cm, update, timings)
     report = _report(cm, fit=fit, dev=dev, sample_dev=sample_dev, iters=iters, timings=timings,
