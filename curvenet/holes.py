@@ -36,6 +36,8 @@ def _plane(points):
     """Centroid ``(3,)``, unit normal ``(3,)`` and in-plane axes ``(2, 3)`` of a point set."""
     c = points.mean(axis=0)
     _, _, vt = np.linalg.svd(points - c, full_matrices=False)
+    if len(vt) < 3:  # a loop of fewer than three points (a short 2-cycle): complete the frame
+        vt = np.linalg.svd(np.vstack([points - c, np.zeros((3 - len(vt), 3))]))[2]
     return c, vt[2], vt[:2]
 
 
