@@ -4,7 +4,8 @@ The curves no patch uses are grouped into *regions*: curves closer to each other
 :data:`REGION_GAP` of the network's diagonal belong together. A region whose curves
 span area (seen in the plane of its two main directions, most of its bounding
 rectangle lies near a curve, and the rectangle is not a sliver) is *surface-like* and
-gets a neural fill; any other region (a single stroke, legs, a stem) stays as wires.
+gets a neural fill when it carries at least :data:`MIN_FILL_LENGTH` of the curve length;
+any other region (a single stroke, legs, a stem, a small detail) stays as wires.
 :func:`plan_regions` makes that decision as data; :func:`trim_fill` keeps of a
 neural surface only the part that fills a region and does not overlap the patches.
 """
@@ -29,6 +30,10 @@ FILL_SHARE = 0.7
 MIN_SPREAD = 0.15
 #: grid cells per side of the rectangle probed for the fill share
 FILL_GRID = 16
+#: a surface-like region gets a neural fill only when it carries at least this share of
+#: the network's curve length: a fill costs a whole neural fit, and a smaller region
+#: (a detail beside dozens of patches) is represented as wires instead
+MIN_FILL_LENGTH = 0.1
 
 
 def _diagonal(curves) -> float:
@@ -65,6 +70,9 @@ def _fill_share(points: np.ndarray, gap: float) -> tuple[float, float]:
 def plan_regions(curves, used, *, gap_rel: float = REGION_GAP) -> list:
     """Regions of the curves no patch uses, each with its route.
 
+    A region is filled when it is surface-like and carries at least
+    :data:`MIN_FILL_LENGTH` of the total curve length; otherwise it is kept as wires.
+
     Parameters
     ----------
     curves : list of (m_i, 3) float64
@@ -93,13 +101,15 @@ def plan_regions(curves, used, *, gap_rel: float = REGION_GAP) -> list:
     if not ids:
         return []
     gap = gap_rel * _diagonal(curves)
+    total = float(sum(np.linalg.norm(np.diff(c, axis=0), axis=1).sum() for c in curves))
     regions = []
     for group in _groups(curves, ids, gap):
         pts = np.concatenate([densify_polyline(curves[i], gap / 4) for i in group])
         fill, spread = _fill_share(pts, gap / 2)
-        surface = len(group) > 1 and fill >= FILL_SHARE and spread >= MIN_SPREAD
         length = float(sum(np.linalg.norm(np.diff(curves[i], axis=0), axis=1).sum()
                            for i in group))
+        surface = (len(group) > 1 and fill >= FILL_SHARE and spread >= MIN_SPREAD
+                   and length >= MIN_FILL_LENGTH * total)
         regions.append({"route": "neural" if surface else "wires", "curves": group,
                         "length": length, "fill": fill, "spread": spread})
     return regions

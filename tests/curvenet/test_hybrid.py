@@ -118,3 +118,17 @@ def test_box_with_a_loose_ribbon_gets_a_neural_fill_and_a_wire(tmp_path):
     ply = trimesh.load(tmp_path / "h.ply", process=False)
     raw = ply.metadata["_ply_raw"]["face"]["data"]["route"]
     np.testing.assert_array_equal(raw, res.face_route)
+
+
+def test_a_small_surface_like_region_stays_wires():
+    # beside a large patched part, a ribbon carrying under MIN_FILL_LENGTH of the curve
+    # length is not worth a neural fit
+    from curvenet.hybrid import MIN_FILL_LENGTH, plan_regions
+    t = np.linspace(0, 1, 20)[:, None]
+    ribbon = [np.hstack([t, 0 * t + y, 0 * t]) for y in np.linspace(0, 0.5, 11)]
+    length = sum(float(np.linalg.norm(np.diff(c, axis=0), axis=1).sum()) for c in ribbon)
+    n_big = int(np.ceil(length / MIN_FILL_LENGTH / 10.0)) + 1
+    big = [np.hstack([10 * t + 5, 0 * t + k, 0 * t]) for k in range(n_big)]
+    used = np.r_[np.zeros(len(ribbon), bool), np.ones(n_big, bool)]
+    assert [r["route"] for r in plan_regions(ribbon + big, used)] == ["wires"]
+    assert [r["route"] for r in plan_regions(ribbon, np.zeros(11, bool))] == ["neural"]
