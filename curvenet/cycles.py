@@ -147,11 +147,9 @@ def find_patches(network: CurveNetwork, *, close: str = "auto", tie_break: str =
     closing patch. A lat-long torus comes out as exactly its faces. The
     handle test is geometric and can misfire on coarse curved faces, so when
     it flags any cycle the paper's order is run too and the one with the
-    smaller manifold defect (curves used
-    by one patch plus curves used by three or more; ``report["manifold_defect"]``)
-    is kept, the paper's on ties (``report["order"]``). On the 29 public
-    networks this changes 4 models (torus_simple, mug, cup, beetle), each to a
-    smaller defect.
+    smaller manifold defect (curves used by one patch plus curves used by three
+    or more; ``report["manifold_defect"]``) is kept, the paper's on ties
+    (``report["order"]``).
 
     References
     ----------
