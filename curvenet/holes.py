@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .core.geometry import fit_plane
 from .loops import cycle_to_loop, loop_points
 from .network import CurveNetwork
 from .patchset import Patch
@@ -32,13 +33,6 @@ __all__ = ["hole_patches", "PLANE_TOL"]
 PLANE_TOL = 1e-4
 
 
-def _plane(points):
-    """Centroid ``(3,)``, unit normal ``(3,)`` and in-plane axes ``(2, 3)`` of a point set."""
-    c = points.mean(axis=0)
-    _, _, vt = np.linalg.svd(points - c, full_matrices=False)
-    if len(vt) < 3:  # a loop of fewer than three points (a short 2-cycle): complete the frame
-        vt = np.linalg.svd(np.vstack([points - c, np.zeros((3 - len(vt), 3))]))[2]
-    return c, vt[2], vt[:2]
 
 
 def hole_patches(network: CurveNetwork, patches, *, plane_tol: float = PLANE_TOL):
@@ -67,7 +61,7 @@ def hole_patches(network: CurveNetwork, patches, *, plane_tol: float = PLANE_TOL
     info = []
     for p in patches:
         pts = loop_points(network, cycle_to_loop(network, p.edges))
-        c, nrm, axes = _plane(pts)
+        c, nrm, axes = fit_plane(pts)
         planar = not p.holes and float(np.abs((pts - c) @ nrm).max()) <= tol
         verts = {network.edges[e].u for e in p.edges} | {network.edges[e].v for e in p.edges}
         info.append((pts, c, nrm, axes, planar, verts))

@@ -21,6 +21,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from curvenet.core.geometry import fit_plane
+
 __all__ = ["split_holed", "split_boundaries", "flatten_planar", "surface_boundaries", "FLAT_TOL"]
 
 #: A patch is flat when its boundary points lie this close to a plane (fraction of the diagonal).
@@ -32,10 +34,6 @@ def _start(curves, item):
     return curves[c][0] if f else curves[c][-1]
 
 
-def _plane(points):
-    c = points.mean(axis=0)
-    _, _, vt = np.linalg.svd(points - c, full_matrices=False)
-    return c, vt[2], vt[:2]
 
 
 def _loop_points(curves, loop):
@@ -55,7 +53,7 @@ def _crosses(p, q, a, b, eps):
 
 def _frame(curves, boundary):
     pts = np.concatenate([_loop_points(curves, lp) for lp in boundary])
-    c, _, _ = _plane(pts)
+    c, _, _ = fit_plane(pts)
     outer = _loop_points(curves, boundary[0])
     n = np.cross(outer, np.roll(outer, -1, axis=0)).sum(axis=0)
     n /= np.linalg.norm(n)
@@ -266,7 +264,7 @@ def flatten_planar(vertices, faces, face_patch, curves, boundaries, tol: float =
     flat = np.zeros(len(boundaries), bool)
     for k, b in enumerate(boundaries):
         pts = np.concatenate([_loop_points(curves, lp) for lp in b])
-        c, n, _ = _plane(pts)
+        c, n, _ = fit_plane(pts)
         flat[k] = np.abs((pts - c) @ n).max() <= tol * diag
         normals[k], offsets[k] = n, n @ c
     V = np.array(vertices, dtype=np.float64)

@@ -32,6 +32,7 @@ __all__ = [
     "densify_polyline",
     "face_normals_areas",
     "sample_surface",
+    "fit_plane",
 ]
 
 
@@ -328,3 +329,34 @@ def sample_surface(vertices: np.ndarray, faces: np.ndarray, n: int, seed=None, *
     points, face_index = trimesh.sample.sample_surface(mesh, int(n), face_weight=areas,
                                                        seed=seed)
     return np.asarray(points, dtype=np.float64), np.asarray(face_index, dtype=np.int64)
+
+
+# --------------------------------------------------------------------------- planes
+def fit_plane(points):
+    """Least-squares plane of a point set.
+
+    Parameters
+    ----------
+    points : (n, 3) float64, n >= 1
+
+    Returns
+    -------
+    centroid : (3,) float64
+    normal : (3,) float64
+        Unit normal: the direction of least spread.
+    axes : (2, 3) float64
+        Unit in-plane directions, of most spread first; with ``normal`` an orthonormal
+        frame even when the points are fewer than three or collinear.
+
+    Examples
+    --------
+    >>> c, n, axes = fit_plane(np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 1, 0]]))
+    >>> np.abs(n).round(6).tolist()
+    [0.0, 0.0, 1.0]
+    """
+    points = np.asarray(points, dtype=np.float64)
+    c = points.mean(axis=0)
+    _, _, vt = np.linalg.svd(points - c, full_matrices=False)
+    if len(vt) < 3:  # fewer than three points: pad with zero rows to complete the frame
+        vt = np.linalg.svd(np.vstack([points - c, np.zeros((3 - len(vt), 3))]))[2]
+    return c, vt[2], vt[:2]

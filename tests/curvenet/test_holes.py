@@ -176,8 +176,8 @@ def test_cad_output_topology(name):
 
 def test_plane_of_a_two_point_loop_is_a_complete_frame():
     # a 2-cycle of two straight curves walks as two points; real sketches have them
-    from curvenet.holes import _plane
-    c, nrm, axes = _plane(np.array([[0.0, 0, 0], [1.0, 0, 0]]))
+    from curvenet.core.geometry import fit_plane
+    c, nrm, axes = fit_plane(np.array([[0.0, 0, 0], [1.0, 0, 0]]))
     frame = np.vstack([axes, nrm])
     np.testing.assert_allclose(frame @ frame.T, np.eye(3), atol=1e-12)
     np.testing.assert_allclose(c, [0.5, 0, 0])
