@@ -296,7 +296,7 @@ def _check_soapfilm(options: dict, settings: SurfaceSettings) -> None:
 def _soapfilm(inp: SurfaceInput, options: dict) -> MeshResult:
     from curvenet.surfacing import soapfilm_loops
     from curvenet.surfacing.holes import split_boundaries
-    curves, loops, _ = split_boundaries(inp.curves, _boundaries(inp))
+    curves, loops, _, _ = split_boundaries(inp.curves, _boundaries(inp))
     return soapfilm_loops(curves, loops, **options)
 
 

@@ -63,6 +63,10 @@ def _frame(curves, boundary):
     return c, np.stack([e1, np.cross(n, e1)])
 
 
+class UnsplittableFace(ValueError):
+    """No set of straight cuts between junctions splits a face with holes into discs."""
+
+
 def _choose_cuts(junctions, loop_of, segments, region, eps):
     """Greedy shortest valid cuts between junctions of different loops (indices into junctions).
 
@@ -89,7 +93,7 @@ def _choose_cuts(junctions, loop_of, segments, region, eps):
         cuts.append((int(i[k]), int(j[k])))
         used |= {i[k], j[k]}
     if not _cut_graph_done([(loop_of[x], loop_of[y]) for x, y in cuts], n_loops):
-        raise ValueError("no set of straight cuts splits the face with holes into discs")
+        raise UnsplittableFace("no set of straight cuts splits the face with holes into discs")
     return cuts
 
 
@@ -222,17 +226,23 @@ def split_boundaries(curves, boundaries, samples: int = 17):
         Simple loops to surface.
     owner : (len(loops),) int64
         Patch index of each loop.
+    unsplit : list of int
+        Patches no straight cuts could split (:class:`UnsplittableFace`): they are
+        surfaced over their outer loop alone, as without hole detection.
     """
     curves = list(curves)
-    loops, owner = [], []
+    loops, owner, unsplit = [], [], []
     for pi, b in enumerate(boundaries):
         subs = [b[0]]
         if len(b) > 1:
-            subs, cuts = split_holed(curves, b, len(curves), samples)
-            curves += cuts
+            try:
+                subs, cuts = split_holed(curves, b, len(curves), samples)
+                curves += cuts
+            except UnsplittableFace:
+                unsplit.append(pi)
         loops += subs
         owner += [pi] * len(subs)
-    return curves, loops, np.asarray(owner, dtype=np.int64)
+    return curves, loops, np.asarray(owner, dtype=np.int64), unsplit
 
 
 def flatten_planar(vertices, faces, face_patch, curves, boundaries, tol: float = FLAT_TOL):
@@ -320,12 +330,13 @@ def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: f
     from . import surface_loops     # the package's, so a patched one is the one called
     from .api import PatchMeshResult
     n = len(curves)
-    all_curves, loops, owner = split_boundaries(curves, boundaries, cut_samples)
+    all_curves, loops, owner, unsplit = split_boundaries(curves, boundaries, cut_samples)
     res = surface_loops(all_curves, loops, **options)
     face_patch = owner[res.face_patch]
     V, flat = flatten_planar(res.vertices, res.faces, face_patch, curves, boundaries, flat_tol)
     report = dict(res.report, n_patches=len(boundaries), n_sectors=len(loops),
-                  cuts=len(all_curves) - n, flat_patches=int(flat.sum()))
+                  cuts=len(all_curves) - n, flat_patches=int(flat.sum()),
+                  unsplit_holes=unsplit)
     new_curves = None if res.curves is None else res.curves[:n]
     return PatchMeshResult(V, res.faces, report, face_patch=face_patch, curves=new_curves,
                            control_vertices=res.control_vertices,

@@ -181,3 +181,19 @@ def test_plane_of_a_two_point_loop_is_a_complete_frame():
     frame = np.vstack([axes, nrm])
     np.testing.assert_allclose(frame @ frame.T, np.eye(3), atol=1e-12)
     np.testing.assert_allclose(c, [0.5, 0, 0])
+
+
+def test_a_face_no_cut_can_split_is_surfaced_over_its_outer_loop(monkeypatch):
+    # e.g. the VNS torus sketch: an equator disc with the inner equator as a hole
+    import curvenet.surfacing.holes as sh
+
+    def refuse(*args, **kwargs):
+        raise sh.UnsplittableFace("no set of straight cuts")
+    monkeypatch.setattr(sh, "split_holed", refuse)
+    t = np.linspace(0, 2 * np.pi, 33)[:, None]
+    outer = np.hstack([2 * np.cos(t), 2 * np.sin(t), 0 * t])
+    inner = np.hstack([np.cos(t), np.sin(t), 0 * t])
+    boundaries = [[[(0, True)]], [[(0, True)], [(1, False)]]]
+    curves, loops, owner, unsplit = sh.split_boundaries([outer, inner], boundaries)
+    assert unsplit == [1] and len(curves) == 2
+    assert loops == [[(0, True)], [(0, True)]] and owner.tolist() == [0, 1]
