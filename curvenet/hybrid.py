@@ -17,7 +17,7 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from .core.geometry import densify_polyline
+from .core.geometry import arc_length, densify_polyline
 
 __all__ = ["REGION_GAP", "plan_regions", "region_strokes", "trim_fill", "assemble"]
 
@@ -101,13 +101,13 @@ def plan_regions(curves, used, *, gap_rel: float = REGION_GAP) -> list:
     if not ids:
         return []
     gap = gap_rel * _diagonal(curves)
-    total = float(sum(np.linalg.norm(np.diff(c, axis=0), axis=1).sum() for c in curves))
+    lengths = [arc_length(c) for c in curves]
+    total = sum(lengths)
     regions = []
     for group in _groups(curves, ids, gap):
         pts = np.concatenate([densify_polyline(curves[i], gap / 4) for i in group])
         fill, spread = _fill_share(pts, gap / 2)
-        length = float(sum(np.linalg.norm(np.diff(curves[i], axis=0), axis=1).sum()
-                           for i in group))
+        length = sum(lengths[i] for i in group)
         surface = (len(group) > 1 and fill >= FILL_SHARE and spread >= MIN_SPREAD
                    and length >= MIN_FILL_LENGTH * total)
         regions.append({"route": "neural" if surface else "wires", "curves": group,
