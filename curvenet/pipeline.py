@@ -258,10 +258,12 @@ def _check_patches_match(sketch: Sketch, ps: PatchSet) -> None:
     """Refuse a patch set whose network was not made from ``sketch``."""
     from scipy.spatial import cKDTree
     net = ps.network
-    strokes = np.concatenate(sketch.select(("boundary", "crease")).strokes or sketch.strokes)
+    drawn = sketch.select(("boundary", "crease"))
+    drawn = drawn if len(drawn) else sketch
+    strokes = np.concatenate(drawn.strokes)
     curves = (np.concatenate([e.curve for e in net.edges]) if net.edges
               else np.asarray(net.positions, np.float64).reshape(-1, 3))
-    diag = float(np.linalg.norm(strokes.max(axis=0) - strokes.min(axis=0)))
+    diag = drawn.diagonal
     if len(curves) == 0 or not diag > 0:
         return
     far = max(float(np.mean(cKDTree(curves).query(strokes)[0] > PATCHES_MATCH_TOL * diag)),
