@@ -15,11 +15,11 @@ from .core.strokes import LABELS
 from .errors import SketchFormatError
 from .sketch import Sketch
 
-__all__ = ["load_text", "xyz_rows", "label_of", "finish_sketch", "split_lines",
-           "MAX_ABS_COORDINATE"]
+__all__ = ["load_text", "xyz_rows", "parse_rows", "nonfinite_error", "label_of",
+           "finish_sketch", "split_lines", "MAX_ABS_COORDINATE"]
 
 #: Files are read in chunks of this many bytes (the read stops past ``max_bytes``).
-_CHUNK_BYTES = 1 << 24
+_CHUNK_BYTES = 1 << 20
 #: Largest coordinate magnitude accepted: squared distances of larger ones overflow float64.
 MAX_ABS_COORDINATE = 1e150
 
@@ -53,28 +53,46 @@ def load_text(path, max_bytes: int) -> str:
         raise SketchFormatError(f"file is larger than the limit of {max_bytes} bytes "
                                 "(pass max_bytes= to raise it)", path=path)
     data = b"".join(chunks)
-    if not data.strip():
+    del chunks  # the joined copy replaces them: at most two copies of the file at once
+    if not data or data.isspace():  # (bytes.strip() would copy the whole file)
         raise SketchFormatError("empty file", path=path)
     try:
-        text = data.decode("utf-8-sig")
+        return data.decode("utf-8-sig")
     except UnicodeDecodeError as err:
         raise SketchFormatError("not UTF-8 text", path=path,
                                 line=data.count(b"\n", 0, err.start) + 1) from None
-    return text
 
 
 def xyz_rows(rows, line_numbers, path, what="coordinates"):
     """Convert a list of token lists (each >= 3 numbers) into ``(n, 3) float64``.
 
-    Raises with the line of the first malformed or non-finite row.
+    Raises with the line of the first malformed or non-finite row (see :func:`parse_rows`).
+    """
+    arr, err = parse_rows(rows, line_numbers, path, what)
+    if err is not None:
+        raise err[2]
+    return arr
+
+
+def parse_rows(rows, line_numbers, path, what="coordinates"):
+    """Convert token lists (the first three of each are used) into ``(n, 3) float64``.
+
+    Returns
+    -------
+    (arr, None) or (None, (rank, line, SketchFormatError))
+        The error is the first row with fewer than three tokens (rank 0), else the
+        first with a token that is not a number (rank 1), else the first with a NaN
+        or infinite value (rank 2); a reader that parses in pieces keeps the error
+        of the smallest ``(rank, line)``, which is the one a single pass would give.
     """
     if not rows:
-        return np.zeros((0, 3))
+        return np.zeros((0, 3)), None
     lens = np.fromiter(map(len, rows), dtype=np.int64, count=len(rows))
     short = np.flatnonzero(lens < 3)
     if short.size:
-        raise SketchFormatError(f"expected 3 {what}, got {lens[short[0]]}", path=path,
-                                line=int(line_numbers[short[0]]))
+        ln = int(line_numbers[short[0]])
+        return None, (0, ln, SketchFormatError(f"expected 3 {what}, got {lens[short[0]]}",
+                                               path=path, line=ln))
     flat = [t for r in rows for t in r[:3]]
     try:
         arr = np.array(flat, dtype=np.float64).reshape(-1, 3)
@@ -83,14 +101,20 @@ def xyz_rows(rows, line_numbers, path, what="coordinates"):
             try:
                 [float(t) for t in r[:3]]
             except ValueError:
-                raise SketchFormatError(f"bad number in {' '.join(r[:3])!r}", path=path,
-                                        line=int(ln)) from None
+                return None, (1, int(ln), SketchFormatError(
+                    f"bad number in {' '.join(r[:3])!r}", path=path, line=int(ln)))
         raise  # pragma: no cover - unreachable: some row must have failed
+    err = nonfinite_error(arr, line_numbers, path)
+    return (arr, None) if err is None else (None, err)
+
+
+def nonfinite_error(arr, line_numbers, path):
+    """``(2, line, SketchFormatError)`` for the first row of ``arr`` with a NaN or inf, or None."""
     bad = np.flatnonzero(~np.isfinite(arr).all(axis=1))
-    if bad.size:
-        raise SketchFormatError("NaN or infinite coordinate", path=path,
-                                line=int(line_numbers[bad[0]]))
-    return arr
+    if not bad.size:
+        return None
+    ln = int(line_numbers[bad[0]])
+    return 2, ln, SketchFormatError("NaN or infinite coordinate", path=path, line=ln)
 
 
 def label_of(name_tokens) -> str | None:

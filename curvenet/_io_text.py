@@ -5,12 +5,13 @@ See :mod:`curvenet.io` for the formats (``# label:`` comments, JSON schema) and 
 
 from __future__ import annotations
 
+import io
 import json
 import re
 
 import numpy as np
 
-from ._io_common import finish_sketch, split_lines, xyz_rows
+from ._io_common import finish_sketch, nonfinite_error, parse_rows
 from .core.geometry import as_polyline
 from .core.strokes import LABELS
 from .errors import InvalidParameterError, SketchFormatError
@@ -22,69 +23,195 @@ _LABEL_RE = re.compile(r"#\s*label\s*:\s*(\w+)", re.IGNORECASE)
 
 
 def read_blocks(text, path, strict, fmt):
-    """Shared reader for ``curves`` (``v n`` headers) and ``txt`` (blank line / CURVE)."""
-    lines, toks = split_lines(text)
-    rows, row_lines, row_stroke = [], [], []
-    starts, labels = [], []  # per stroke: first line, label
-    pending_label = None
-    expect = None  # curves: points still expected in the current block
-    open_block = False
-    for i, t in enumerate(toks):
-        ln = i + 1
-        if not t:
-            if fmt == "txt":
-                open_block = False
-            continue
-        if t[0].startswith("#"):
-            m = _LABEL_RE.match(lines[i].strip())
+    """Shared reader for ``curves`` (``v n`` headers) and ``txt`` (blank line / CURVE).
+
+    The text is read in pieces of whole lines (about :data:`_PIECE_CHARS` characters).
+    In a piece of plain ASCII, the lines of coordinates are found with numpy on its
+    bytes and parsed in one ``numpy.loadtxt`` call; only the other lines (comments,
+    headers, blank lines that end a block) are looked at one by one. A piece the
+    vectorised reading does not cover exactly (a bad number, a short row, other
+    line breaks or non-ASCII text) is read token by token. Either way the temporary
+    memory is bounded by the piece, and the errors are those of a token-by-token
+    reading of the whole file (:func:`curvenet._io_common.parse_rows`).
+    """
+    blocks = _Blocks(path, fmt)
+    for piece in _pieces(text, _PIECE_CHARS):
+        if not blocks.fast_piece(piece):
+            blocks.slow_piece(piece)
+    return blocks.finish(strict)
+
+
+#: Characters per piece of :func:`read_blocks` (whole lines; bounds its temporary memory).
+_PIECE_CHARS = 1 << 18
+#: Bytes the vectorised reading treats as blanks inside a line.
+_BLANK = np.zeros(256, dtype=bool)
+_BLANK[[ord(" "), ord("\t"), ord("\r")]] = True
+#: First bytes of a line of coordinates.
+_NUMBER = np.zeros(256, dtype=bool)
+_NUMBER[list(b"0123456789+-.")] = True
+#: Bytes that ``str.split``/``str.splitlines`` treat as blanks or line breaks and the
+#: vectorised reading does not (pieces with them are read token by token).
+_ODD = np.zeros(256, dtype=bool)
+_ODD[[0x0B, 0x0C, 0x1C, 0x1D, 0x1E, 0x1F]] = True
+
+
+def _pieces(text, size):
+    """Consecutive slices of ``text`` of at least ``size`` characters, ending at a newline."""
+    pos = 0
+    while pos < len(text):
+        end = text.find("\n", pos + size)
+        end = len(text) if end < 0 else end + 1
+        yield text[pos:end]
+        pos = end
+
+
+class _Blocks:
+    """The state of reading ``curves``/``txt`` blocks: strokes so far and the open block."""
+
+    def __init__(self, path, fmt):
+        self.path, self.fmt = path, fmt
+        self.starts, self.labels, self.counts = [], [], []  # per stroke
+        self.pending_label = None
+        self.expect = None  # curves: points still expected in the current block
+        self.open_block = False
+        self.arrays = []  # coordinates, in file order
+        self.error = None  # the coordinate error to raise: smallest (rank, line, error)
+        self.lines = 0  # lines read so far
+
+    def kind(self, toks):
+        """'blank', 'comment', 'header' or 'row' for a line's tokens."""
+        if not toks:
+            return "blank"
+        if toks[0].startswith("#"):
+            return "comment"
+        head = toks[0] if self.fmt == "curves" else toks[0].upper()
+        return "header" if head == ("v" if self.fmt == "curves" else "CURVE") else "row"
+
+    def rows(self, lines):
+        """Give the coordinate rows on ``lines`` (1-based, increasing) to the open block."""
+        if self.fmt == "curves":
+            if not self.expect or len(lines) > self.expect:
+                raise SketchFormatError("point outside a 'v <count>' block", path=self.path,
+                                        line=int(lines[self.expect or 0]))
+            self.expect -= len(lines)
+        elif not self.open_block:
+            self._start(int(lines[0]))
+            self.open_block = True
+        self.counts[-1] += len(lines)
+
+    def _start(self, ln):
+        self.starts.append(ln)
+        self.labels.append(self.pending_label or "boundary")
+        self.pending_label = None
+        self.counts.append(0)
+
+    def line(self, ln, line, toks):
+        """Read one line; returns whether it is a coordinate row (its values are not read)."""
+        kind = self.kind(toks)
+        if kind == "blank":
+            if self.fmt == "txt":
+                self.open_block = False
+        elif kind == "comment":
+            m = _LABEL_RE.match(line.strip())
             if m:
                 lab = m.group(1).lower()
                 if lab not in LABELS:
-                    raise SketchFormatError(f"unknown label {lab!r}", path=path, line=ln)
-                pending_label = lab
-            continue
-        if fmt == "curves":
-            if t[0] == "v":
-                if expect:
-                    raise SketchFormatError(f"block ended {expect} point(s) early", path=path,
-                                            line=ln)
-                try:
-                    expect = int(t[1])
-                except (IndexError, ValueError):
-                    raise SketchFormatError("expected 'v <count>'", path=path,
-                                            line=ln) from None
-                if expect < 0:
-                    raise SketchFormatError(f"negative point count {expect}", path=path, line=ln)
-                starts.append(ln)
-                labels.append(pending_label or "boundary")
-                pending_label = None
-                continue
-            if not expect:
-                raise SketchFormatError("point outside a 'v <count>' block", path=path,
+                    raise SketchFormatError(f"unknown label {lab!r}", path=self.path, line=ln)
+                self.pending_label = lab
+        elif kind == "header" and self.fmt == "txt":
+            self.open_block = False
+        elif kind == "header":
+            if self.expect:
+                raise SketchFormatError(f"block ended {self.expect} point(s) early",
+                                        path=self.path, line=ln)
+            try:
+                self.expect = int(toks[1])
+            except (IndexError, ValueError):
+                raise SketchFormatError("expected 'v <count>'", path=self.path,
+                                        line=ln) from None
+            if self.expect < 0:
+                raise SketchFormatError(f"negative point count {self.expect}", path=self.path,
                                         line=ln)
-            expect -= 1
+            self._start(ln)
         else:
-            if t[0].upper() == "CURVE":
-                open_block = False
-                continue
-            if not open_block:
-                starts.append(ln)
-                labels.append(pending_label or "boundary")
-                pending_label = None
-                open_block = True
-        rows.append(t)
-        row_lines.append(ln)
-        row_stroke.append(len(starts) - 1)
-    if fmt == "curves" and expect:
-        raise SketchFormatError(f"file ends {expect} point(s) short of the last block",
-                                path=path, line=len(lines))
-    if not starts:
-        raise SketchFormatError("no strokes", path=path)
-    pts = xyz_rows(rows, row_lines, path)
-    sid = np.asarray(row_stroke, dtype=np.int64)
-    counts = np.bincount(sid, minlength=len(starts))
-    strokes = np.split(pts, np.cumsum(counts)[:-1])
-    return finish_sketch(strokes, labels, starts, path, strict)
+            self.rows([ln])
+        return kind == "row"
+
+    def _values(self, arr, err):
+        if err is not None and (self.error is None or err[:2] < self.error[:2]):
+            self.error = err
+        if self.error is None:
+            self.arrays.append(arr)
+
+    def slow_piece(self, piece):
+        """Read a piece line by line, its coordinates token by token."""
+        rows, row_lines = [], []
+        lines = piece.splitlines()
+        for i, line in enumerate(lines):
+            toks = line.split()
+            if self.line(self.lines + i + 1, line, toks):
+                rows.append(toks)
+                row_lines.append(self.lines + i + 1)
+        self.lines += len(lines)
+        self._values(*parse_rows(rows, row_lines, self.path))
+
+    def fast_piece(self, piece):
+        """Read a piece with vectorised coordinate lines; False (nothing read) if it has
+        lines that only the token-by-token reading reads exactly."""
+        if not piece.isascii():
+            return False
+        raw = piece.encode("ascii") + (b"" if piece.endswith("\n") else b"\n")
+        b = np.frombuffer(raw, dtype=np.uint8)
+        cr = np.flatnonzero(b == 13)
+        if _ODD[b].any() or (b[cr + 1] != 10).any():  # \r only in \r\n
+            return False
+        ends = np.flatnonzero(b == 10)
+        starts = np.concatenate([[0], ends[:-1] + 1])
+        ink = np.flatnonzero(~_BLANK[b])  # includes the newlines
+        head = b[ink[np.searchsorted(ink, starts)]]  # first non-blank byte of each line
+        num = _NUMBER[head]
+        other = np.flatnonzero(~num & ((head != 10) | (self.fmt == "txt")))
+        texts = [raw[starts[i]:ends[i]].decode("ascii") for i in other.tolist()]
+        toks = [t.split() for t in texts]
+        if any(self.kind(t) == "row" for t in toks):
+            return False
+        vals = np.zeros((0, 3))
+        if num.any():
+            keep = np.repeat(num, ends - starts + 1)
+            try:
+                vals = np.loadtxt(io.BytesIO(b[keep].tobytes()), dtype=np.float64,
+                                  comments=None, usecols=(0, 1, 2), ndmin=2)
+            except ValueError:
+                return False
+        rows = np.flatnonzero(num) + self.lines + 1  # 1-based lines of the coordinates
+        if len(vals) != len(rows):
+            return False
+        cut = np.searchsorted(rows, other + self.lines + 1)
+        prev = 0
+        for i, c, text, t in zip(other.tolist(), cut.tolist(), texts, toks):
+            if c > prev:
+                self.rows(rows[prev:c])
+            prev = c
+            self.line(self.lines + i + 1, text, t)
+        if prev < len(rows):
+            self.rows(rows[prev:])
+        self.lines += len(ends)
+        self._values(vals, nonfinite_error(vals, rows, self.path))
+        return True
+
+    def finish(self, strict):
+        """The sketch, or the first error a token-by-token reading would raise."""
+        if self.fmt == "curves" and self.expect:
+            raise SketchFormatError(f"file ends {self.expect} point(s) short of the last block",
+                                    path=self.path, line=self.lines)
+        if not self.starts:
+            raise SketchFormatError("no strokes", path=self.path)
+        if self.error is not None:
+            raise self.error[2]
+        pts = np.concatenate(self.arrays) if len(self.arrays) != 1 else self.arrays[0]
+        self.arrays = []  # the one copy left is pts
+        strokes = np.split(pts, np.cumsum(self.counts)[:-1])
+        return finish_sketch(strokes, self.labels, self.starts, self.path, strict)
 
 
 def read_json(text, path, strict):

@@ -41,8 +41,11 @@ unknown format, a file larger than ``max_bytes`` (default
 with a warning (kept in ``sketch.metadata["warnings"]``) when other strokes
 remain, and are an error with ``strict=True`` or when nothing remains.
 
-Parsing is vectorised with numpy (one pass of ``str.split`` per line, then a
-single array conversion), so a 100 MB OBJ reads in a few seconds.
+Parsing is vectorised with numpy: OBJ with one pass of ``str.split`` per line,
+then a single array conversion, so a 100 MB OBJ reads in a few seconds;
+``curves`` and ``txt`` in pieces of whole lines whose coordinate lines go
+through one ``numpy.loadtxt`` call each, so the memory a read holds is a few
+copies of the file and of its coordinates (figures in ``benchmarks/README.md``).
 
 Layout
 ------
@@ -187,6 +190,7 @@ def read_sketch(path, *, format: str | None = None, strict: bool = False,
         sketch = finish_sketch(strokes, labels, [None] * len(strokes), path, strict, meta)
     else:
         sketch = read_blocks(text, path, strict, fmt)
+    del text  # the strokes are parsed: free the file's text before the point-block pass
     from .pointcurves import read_point_blocks
     return read_point_blocks(sketch, points)
 

@@ -178,6 +178,103 @@ def test_curves_and_txt_blocks(tmp_path):
     np.testing.assert_array_equal(sk.strokes[1][0], [5, 5, 5])
 
 
+def _read_outcome(path):
+    """(strokes, labels, warnings) of reading ``path``, or (message, line) of its error."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            sk = read_sketch(path)
+    except SketchFormatError as err:
+        return str(err), err.line
+    return [s.tolist() for s in sk.strokes], sk.labels, sk.metadata.get("warnings")
+
+
+_TEXTS = {  # name -> content; the clean ones take the vectorised path
+    "crlf.txt": "# label: crease\r\n0 0 0\r\n1 0 0\r\n\r\n2 2 2\r\n3 3 3\r\n",
+    "indent.txt": "  0 0 0\n\t1 0 0 \n\n\n  # label: construction\n 5 5 5\n6 6 6\n",
+    "columns.txt": "0 0 0 1\n1 0 0 7 foo\n2 1 0 # note\n",
+    "headers.txt": "CURVE 0\n0 0 0\n1 0 0\ncurve 1\n5 5 5\n6 6 6\n\n7 7 7\n8 8 8\n",
+    "one.txt": "0 0 0\n\n1 1 1\n2 2 2\n",
+    "blocks.curves": "# label: crease\nv 2\n0 0 0\n1 0 0\n\nv 3\n0 1 0\n\n1 1 0\n2 1 0\n",
+    "underscore.txt": "0 0 0\n1_0 0 0\n",  # Python floats: token by token
+    "nbsp.txt": "0\u00a00 0\n1 0 0\n",
+    "lone_cr.txt": "0 0 0\r1 0 0\r\n2 0 0\n",
+    "formfeed.txt": "0 0 0\n\x0c\n1 0 0\n",
+    "nan_word.txt": "0 0 0\nnan 0 0\n",
+    "v_row.txt": "0 0 0\nv 1 0 0\n",
+    "bad.txt": "0 0 0\n1 x 0\n",
+    "short.txt": "0 0 0\n1 0\n2 0 0\n",
+    "inf.txt": "0 0 0\n1 1e400 0\n",
+    "bad_then_short.txt": "0 0 0\n1 x 0\n2 0 0\n\n3 0\n",
+    "inf_then_bad.txt": "0 1 inf\n1 1 1\n\n2 y 2\n3 3 3\n",
+    "bad_then_label.txt": "0 0 0\n1 x 0\n# label: wall\n2 0 0\n3 0 0\n",
+    "early.curves": "v 3\n0 0 0\n1 0 0\nv 2\n0 0 0\n1 0 0\n",
+    "outside.curves": "v 2\n0 0 0\n1 0 0\n2 0 0\n",
+    "short_end.curves": "v 2\n0 0 0\n1 0 0\nv 4\n0 1 0\n",
+    "negative.curves": "v -2\n0 0 0\n",
+    "header.curves": "v\n0 0 0\n",
+    "no_newline.txt": "0 0 0\n1 0 0",
+}
+
+
+def test_text_reader_in_pieces_equals_token_by_token_reading(tmp_path, monkeypatch):
+    """Oracle: the vectorised reading in small pieces gives the strokes, labels, warnings and
+    the first error (message and line) of a token-by-token reading of the whole file."""
+    from curvenet import _io_text
+
+    files = []
+    for name, text in _TEXTS.items():
+        files.append(tmp_path / name)
+        files[-1].write_bytes(text.encode("utf-8"))
+    for i, fmt in enumerate(("txt", "curves")):
+        sk = _sketch(10 + i, 40)
+        files.append(tmp_path / f"random.{fmt}")
+        write_sketch(files[-1], sk)
+        text = files[-1].read_text().splitlines(keepends=True)
+        for k, bad in enumerate(("1 2 nan\n", "0.5 y 0\n", "0.5\n")):  # an error deep inside
+            files.append(tmp_path / f"random_{k}.{fmt}")
+            line = len(text) // 2 + 7 * k
+            files[-1].write_text("".join(text[:line] + [bad] + text[line + 1:]))
+    fast = []
+    real = _io_text._Blocks.fast_piece
+    monkeypatch.setattr(_io_text._Blocks, "fast_piece",
+                        lambda self, piece: fast.append(real(self, piece)) or fast[-1])
+    outcomes = {}
+    for size in (8, 100):
+        monkeypatch.setattr(_io_text, "_PIECE_CHARS", size)
+        outcomes[size] = [_read_outcome(f) for f in files]
+    assert sum(fast) > 100 and not all(fast)  # both ways were taken
+    monkeypatch.setattr(_io_text._Blocks, "fast_piece", lambda self, piece: False)
+    monkeypatch.setattr(_io_text, "_PIECE_CHARS", 1 << 40)  # the file as one piece
+    for f, a, b, c in zip(files, outcomes[8], outcomes[100], [_read_outcome(f) for f in files]):
+        assert a == c and b == c, f.name
+    assert _read_outcome(tmp_path / "crlf.txt")[1] == ["crease", "boundary"]
+    assert _read_outcome(tmp_path / "inf_then_bad.txt")[1] == 4  # a bad number goes first
+    assert _read_outcome(tmp_path / "bad_then_label.txt")[1] == 3  # a wrong label before both
+
+
+def test_text_reader_memory_is_a_small_multiple_of_the_points(tmp_path):
+    """Reading a text sketch keeps at most a few copies of the file and of its coordinates
+    alive (the token-by-token reading held about 25 times the coordinates in Python objects)."""
+    import tracemalloc
+
+    rng = np.random.default_rng(5)
+    sk = Sketch([np.round(np.cumsum(rng.normal(size=(100, 3)), axis=0), 5)
+                 for _ in range(2000)])
+    p = tmp_path / "mid.txt"
+    write_sketch(p, sk)
+    read_sketch(p)  # imports and caches outside the measurement
+    tracemalloc.start()
+    try:
+        back = read_sketch(p)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    coords = sum(s.nbytes for s in back.strokes)
+    assert coords == 200_000 * 24 and p.stat().st_size < 1.2 * coords
+    assert peak < 4.5 * coords, peak / coords
+
+
 # --------------------------------------------------------------------------- bad input
 BAD = {
     "empty.obj": ("", None),
