@@ -183,8 +183,8 @@ def _surface_file(local: str, options: BatchOptions, tmp: str, *, preview, tile,
     out["t_fidelity"] = time.perf_counter() - t
     if "." + options.format in CAD_FORMATS:
         data = _cad_bytes(res, Path(tmp, f"out.{options.format}"), out)
-    else:
-        data = res.mesh.export(file_type=options.format)
+    else:   # OBJ keeps the route groups and the wires (``SurfaceResult.save``)
+        data = res.save(Path(tmp, f"out.{options.format}")).read_bytes()
     cov = res.diagnostics.get("coverage")
     out.update(route=res.method, decision=res.diagnostics.get("decision", ""),
                patches=res.diagnostics.get("patches"),
@@ -194,18 +194,19 @@ def _surface_file(local: str, options: BatchOptions, tmp: str, *, preview, tile,
                mesh_bytes=data.encode() if isinstance(data, str) else bytes(data))
     name = Path(local).name
     strokes = res.sketch if res.sketch is not None else None
+    routed = dict(face_route=res.face_route, routes=res.routes, wires=res.wires)
     t = time.perf_counter()
     if preview:
         from .preview import render_preview
         png = Path(tmp, "preview.png")
         render_preview(png, strokes=strokes, network=res.network, mesh=res.mesh,
-                       title=f"{name}: {res.method}", up=up)
+                       title=f"{name}: {res.method}", up=up, **routed)
         out["preview_png"] = png.read_bytes()
     if tile:
         from .preview import render_preview
         png = Path(tmp, "tile.png")
         render_preview(png, mesh=res.mesh, network=res.network, view=(20.0, -60.0),
-                       size=TILE_SIZE, up=up)
+                       size=TILE_SIZE, up=up, **routed)
         out["tile_png"] = png.read_bytes()
     if preview or tile:
         out["t_preview"] = time.perf_counter() - t

@@ -246,7 +246,8 @@ def _surface_one(inp: str, out: str, args) -> dict:
             from .preview import render_preview
             prev = args.preview if args.output else str(Path(out).with_suffix(".png"))
             render_preview(prev, strokes=res.sketch, network=res.network, mesh=res.mesh,
-                           title=f"{Path(inp).name}: {res.method}", up=args.up)
+                           title=f"{Path(inp).name}: {res.method}", up=args.up,
+                           face_route=res.face_route, routes=res.routes, wires=res.wires)
         return {"input": inp, "output": out, "status": "ok", "method": res.method,
                 "faces": len(res.mesh.faces), "seconds": time.perf_counter() - t0,
                 "why": res.decision.explain(), "interrupted": res.interrupted,

@@ -8,6 +8,10 @@ gets a neural fill when it carries at least :data:`MIN_FILL_LENGTH` of the curve
 any other region (a single stroke, legs, a stem, a small detail) stays as wires.
 :func:`plan_regions` makes that decision as data; :func:`trim_fill` keeps of a
 neural surface only the part that fills a region and does not overlap the patches.
+:func:`stroke_wires` keeps what the surface leaves out of the sketch: every stretch of a
+stroke farther from the surface than the fidelity tolerance (the strokes of wire regions,
+overshoots trimmed by the snapping, the second stroke of an overdrawn curve), with the
+stroke's own geometry.
 """
 
 from __future__ import annotations
@@ -17,9 +21,11 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from .core.geometry import arc_length, densify_polyline
+from .core.geometry import arc_length, cumulative_length, densify_polyline, interpolate_polyline
+from .evaluate import FIDELITY_TOL_REL, STROKE_SPACING_REL, _stroke_list, point_surface_distance
 
-__all__ = ["REGION_GAP", "plan_regions", "region_strokes", "trim_fill", "assemble"]
+__all__ = ["REGION_GAP", "plan_regions", "region_strokes", "trim_fill", "assemble",
+           "stroke_wires"]
 
 #: curves closer than this fraction of the network's diagonal form one region
 REGION_GAP = 0.08
@@ -34,6 +40,9 @@ FILL_GRID = 16
 #: the network's curve length: a fill costs a whole neural fit, and a smaller region
 #: (a detail beside dozens of patches) is represented as wires instead
 MIN_FILL_LENGTH = 0.1
+#: a stretch of stroke off the surface becomes a wire when it is at least this long,
+#: as a fraction of the sketch's diagonal (shorter ones are the surface's wobble)
+MIN_WIRE_LENGTH = 0.01
 
 
 def _diagonal(curves) -> float:
@@ -151,7 +160,6 @@ def trim_fill(vertices, faces, region_curves, patch_vertices, patch_faces, *,
     (F,) bool
         The faces kept.
     """
-    from .evaluate import point_surface_distance
     centroids = np.asarray(vertices)[np.asarray(faces)].mean(axis=1)
     dense = np.concatenate([densify_polyline(c, gap / 4) for c in region_curves])
     near = cKDTree(dense).query(centroids)[0] < gap
@@ -159,6 +167,86 @@ def trim_fill(vertices, faces, region_curves, patch_vertices, patch_faces, *,
         off = point_surface_distance(centroids, patch_vertices, patch_faces)[0] > gap / 4
         near &= off
     return near
+
+
+def stroke_wires(strokes, vertices, faces, *, tol_rel: float = FIDELITY_TOL_REL,
+                 spacing_rel: float = STROKE_SPACING_REL,
+                 min_length_rel: float = MIN_WIRE_LENGTH) -> list:
+    """Stretches of the strokes that the surface does not pass through, as wires.
+
+    Parameters
+    ----------
+    strokes : Sketch, CurveNetwork or list of (n, 3) array_like
+        As in :func:`curvenet.evaluate.sketch_fidelity`; the diagonal of their points is
+        the scale of the relative lengths below.
+    vertices : (V, 3) float64
+    faces : (F, 3) int64
+        The surface.
+    tol_rel : float
+        A stroke sample farther than this from the surface is off it (the fidelity
+        tolerance).
+    spacing_rel : float
+        Arc-length step of the stroke samples.
+    min_length_rel : float
+        Stretches shorter than this are left out.
+
+    Returns
+    -------
+    list of (m, 3) float64
+        One piece of one stroke each (m >= 2), in stroke order: the stroke's own points
+        from the sample before its first sample off the surface to the sample after its
+        last (so a wire starts and ends at the surface when it leaves it), the two ends
+        interpolated on the stroke.
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> box = trimesh.creation.box()
+    >>> stroke = [[-0.5, -0.5, 0.5], [0.5, -0.5, 0.5], [1.5, -0.5, 0.5]]
+    >>> [w.round(3).tolist() for w in stroke_wires([stroke], box.vertices, box.faces)]
+    [[[0.518, -0.5, 0.5], [1.5, -0.5, 0.5]]]
+    """
+    lines = [np.asarray(s, np.float64) for s in _stroke_list(strokes)]
+    diag = _diagonal(lines)
+    dense = [densify_polyline(p, spacing_rel * diag) for p in lines]
+    pts = np.concatenate(dense)
+    off = point_surface_distance(pts, vertices, faces)[0] >= tol_rel * diag
+    sid = np.repeat(np.arange(len(dense)), [len(p) for p in dense])
+    first = np.r_[0, np.cumsum([len(p) for p in dense])[:-1]]
+    step = np.r_[0.0, np.linalg.norm(np.diff(pts, axis=0), axis=1)]
+    step[first] = 0.0
+    cum = np.cumsum(step) - np.cumsum(step)[first][sid]   # arc length along each stroke
+    same = sid[1:] == sid[:-1]
+    starts = np.flatnonzero(off & ~np.r_[False, off[:-1] & same])
+    ends = np.flatnonzero(off & ~np.r_[off[1:] & same, False])
+    last = first + [len(p) - 1 for p in dense]
+    lo = np.maximum(starts - 1, first[sid[starts]])
+    hi = np.minimum(ends + 1, last[sid[ends]])
+    wires = []
+    for a, b in zip(lo, hi):
+        s0, s1, line = cum[a], cum[b], lines[sid[a]]
+        if s1 - s0 < min_length_rel * diag:
+            continue
+        c = cumulative_length(line)
+        eps = 1e-3 * spacing_rel * diag   # float noise of the two arc lengths
+        inner = line[(c > s0 + eps) & (c < s1 - eps)]
+        wires.append(np.concatenate([interpolate_polyline(line, [s0], cum=c), inner,
+                                     interpolate_polyline(line, [s1], cum=c)]))
+    return wires
+
+
+def add_wires(out) -> None:
+    """Keep as ``out.wires`` the stretches of strokes ``out.mesh`` leaves out, in place.
+
+    The strokes are the sketch's (the network's curves without a sketch); see
+    :func:`stroke_wires`. A result with wires but no face routes gets one route, the
+    decision's, for every face.
+    """
+    ref = out.sketch if out.sketch is not None else out.network
+    out.wires = stroke_wires(ref, out.mesh.vertices, out.mesh.faces)
+    if out.wires and not out.routes:
+        out.routes = (out.decision.method,)
+        out.face_route = np.zeros(len(out.mesh.faces), np.uint8)
 
 
 def _fill(out, classical, region, used, gap, plan, settings, run):
@@ -194,8 +282,9 @@ def assemble(out, classical, plan, settings, run) -> None:
         ``run(surfacer, inp, options, timings, diagnostics) -> MeshResult``.
 
     ``out.mesh`` becomes the classical faces followed by the kept neural faces,
-    ``out.face_route`` their route (0 classical, 1 neural), ``out.wires`` the curves of
-    the wire regions, ``out.method`` ``"hybrid"`` when a fill kept faces.
+    ``out.face_route`` their route (0 classical, 1 neural), ``out.method`` ``"hybrid"``
+    when a fill kept faces. The wire regions get no surface: :func:`add_wires` keeps
+    their strokes.
     """
     import trimesh
     edges = out.network.edges
@@ -205,8 +294,7 @@ def assemble(out, classical, plan, settings, run) -> None:
     verts, faces = [np.asarray(classical.vertices)], [np.asarray(classical.faces)]
     routes = [np.zeros(len(classical.faces), np.uint8)]
     for region in out.decision.regions[1:]:
-        if region["route"] == "wires":
-            out.wires += [edges[i].curve for i in region["curves"]]
+        if region["route"] == "wires":   # its strokes become wires (:func:`add_wires`)
             continue
         v, f = _fill(out, classical, region, used, gap, plan, settings, run)
         faces.append(f + sum(len(x) for x in verts))

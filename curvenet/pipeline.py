@@ -62,7 +62,9 @@ class SurfaceResult:
     decision : RouteDecision or None
         The route decision as data (``dataclasses.asdict`` makes it JSON).
     wires : list of (m, 3) float64
-        Curves that bound nothing, kept as polylines beside the mesh (``auto`` only).
+        Stretches of strokes the surface does not pass through (strokes that bound
+        nothing, trimmed overshoots, overdrawn strokes), with the strokes' own geometry,
+        kept as polylines beside the mesh (``auto`` only; :func:`curvenet.hybrid.add_wires`).
     face_route : (F,) uint8 or None
         Per face, an index into ``routes``: the route that made it.
     routes : tuple of str
@@ -498,6 +500,9 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
     if decision.regions:
         from .hybrid import assemble
         assemble(out, res, plan, settings, _run)
+    if method == "auto":
+        from .hybrid import add_wires
+        add_wires(out)
     _fidelity(out)
     return out
 

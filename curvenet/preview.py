@@ -19,7 +19,7 @@ from .core.tolerances import COINCIDENT_REL, DIVISION_GUARD, ZERO_LENGTH
 from .errors import InvalidParameterError
 
 __all__ = ["render_preview", "patch_polygons", "decimate_clustering", "DEFAULT_VIEWS",
-           "MAX_PREVIEW_FACES"]
+           "MAX_PREVIEW_FACES", "ROUTE_COLOURS", "WIRE_COLOUR"]
 
 #: Default camera(s): ``(elevation, azimuth)`` in degrees, one panel each (front and back).
 DEFAULT_VIEWS = ((20.0, -60.0), (20.0, 120.0))
@@ -47,6 +47,10 @@ _STROKE_COLOUR = (0.25, 0.25, 0.25)
 _CONSTRUCTION_COLOUR = (0.65, 0.65, 0.65)
 _EDGE_COLOURS = {"boundary": (0.12, 0.23, 0.45), "crease": (0.75, 0.22, 0.17)}
 _MESH_COLOUR = np.array([0.72, 0.76, 0.82])
+#: Face colour per route of a routed surface (``face_route``); other routes are grey.
+ROUTE_COLOURS = {"classical": (0.55, 0.68, 0.88), "neural": (0.93, 0.60, 0.32)}
+#: Wires (strokes kept beside the surface).
+WIRE_COLOUR = (0.10, 0.55, 0.25)
 #: Highlight (a suggested patch): saturated orange, not produced by the patch palette
 #: (its saturation is 0.45), so tests can find it in the picture.
 HIGHLIGHT_COLOUR = (1.0, 0.45, 0.0)
@@ -128,7 +132,7 @@ def _fan(polygon, rings: int = 1):
     return np.concatenate([inner, quads])
 
 
-def decimate_clustering(vertices, faces, max_faces: int) -> tuple[np.ndarray, np.ndarray]:
+def decimate_clustering(vertices, faces, max_faces: int, *, return_index: bool = False):
     """Reduce a triangle mesh to at most ``max_faces`` faces by vertex clustering.
 
     Parameters
@@ -136,12 +140,16 @@ def decimate_clustering(vertices, faces, max_faces: int) -> tuple[np.ndarray, np
     vertices : (V, 3) float64
     faces : (F, 3) int64
     max_faces : int
+    return_index : bool
+        Also return the input face each output face comes from.
 
     Returns
     -------
     vertices : (V', 3) float64
     faces : (F', 3) int64
         ``F' <= max_faces``; unchanged input when ``F <= max_faces``.
+    index : (F',) int64
+        Only with ``return_index``: the input face of each output face.
 
     Notes
     -----
@@ -155,7 +163,7 @@ def decimate_clustering(vertices, faces, max_faces: int) -> tuple[np.ndarray, np
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
     if len(f) <= max_faces:
-        return v, f
+        return (v, f, np.arange(len(f))) if return_index else (v, f)
     tri = v[f]
     area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]),
                                 axis=1).sum()
@@ -171,6 +179,7 @@ def decimate_clustering(vertices, faces, max_faces: int) -> tuple[np.ndarray, np
         nf = nf[ok]
         # drop duplicate triangles (same corners, any rotation or orientation)
         _, first = np.unique(np.sort(nf, axis=1), axis=0, return_index=True)
+        index = np.flatnonzero(ok)[np.sort(first)]
         nf = nf[np.sort(first)]
         if len(nf) <= max_faces:
             break
@@ -179,6 +188,8 @@ def decimate_clustering(vertices, faces, max_faces: int) -> tuple[np.ndarray, np
     nv = np.stack([np.bincount(inverse, weights=v[:, k]) for k in range(3)], axis=1)
     nv /= count[:, None]
     used, nf = np.unique(nf, return_inverse=True)
+    if return_index:
+        return nv[used], nf.reshape(-1, 3), index
     return nv[used], nf.reshape(-1, 3)
 
 
@@ -258,7 +269,7 @@ def _views(view):
 # ---------------------------------------------------------------------------
 def render_preview(path, *, strokes=None, network=None, patches=None, mesh=None,
                    highlight=None, title=None, view=None, size=(900, 700),
-                   up: str = "z") -> Path:
+                   up: str = "z", face_route=None, routes=(), wires=()) -> Path:
     """Draw a PNG picture of a sketch, its network, its patches and/or a surface.
 
     Parameters
@@ -290,6 +301,13 @@ def render_preview(path, *, strokes=None, network=None, patches=None, mesh=None,
     up : {"z", "y", "x"}, default "z"
         The data's up axis (many OBJ sketches are y-up); the picture is rotated so
         that it points up.
+    face_route : (F,) int, optional
+        Per face of ``mesh``, an index into ``routes``: faces are coloured by route
+        (:data:`ROUTE_COLOURS`) and a legend names them.
+    routes : sequence of str
+        Route names of ``face_route`` (``("classical", "neural")``).
+    wires : list of (m, 3) array_like
+        Polylines kept beside the surface, drawn in :data:`WIRE_COLOUR`.
 
     Returns
     -------
@@ -327,9 +345,12 @@ def render_preview(path, *, strokes=None, network=None, patches=None, mesh=None,
     edge_sets, network = _patch_list(patches, network)
     hl_index, hl_extra, hl_edges = _highlights(highlight, edge_sets, network)
     fans = _patch_fans(network, edge_sets, hl_index, hl_extra)
-    mesh_v, mesh_f = _preview_mesh(mesh)
-    scene = _Scene.build(rot, lines, line_colours, network, hl_edges, fans, mesh_v, mesh_f)
+    mesh_v, mesh_f, mesh_rgb = _preview_mesh(mesh, face_route, routes)
+    wires = [as_polyline(w, name=f"wires[{i}]") for i, w in enumerate(wires)]
+    scene = _Scene.build(rot, lines, line_colours, network, hl_edges, fans, mesh_v, mesh_f,
+                         mesh_rgb, wires)
     fig = _figure(scene, views, width, height, title)
+    _legend(fig, routes if face_route is not None else (), bool(wires))
     path = Path(path)
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format="png", dpi=100, facecolor="white")
@@ -410,14 +431,37 @@ def _patch_fans(network, edge_sets, hl_index, hl_extra):
     return tris, rgb, amb
 
 
-def _preview_mesh(mesh):
-    """``(vertices, faces)`` of ``mesh`` decimated to :data:`MAX_PREVIEW_FACES`, or Nones."""
+def _preview_mesh(mesh, face_route, routes):
+    """``(vertices, faces, rgb)`` of ``mesh`` decimated to :data:`MAX_PREVIEW_FACES`.
+
+    ``rgb`` is (F', 3) per face by route (None without ``face_route``); all None
+    without a mesh.
+    """
     if mesh is None:
-        return None, None
+        return None, None, None
     from .evaluate import load_mesh_arrays
 
     mesh_v, mesh_f = load_mesh_arrays(mesh, name="mesh")
-    return decimate_clustering(mesh_v, mesh_f, MAX_PREVIEW_FACES)
+    v, f, index = decimate_clustering(mesh_v, mesh_f, MAX_PREVIEW_FACES, return_index=True)
+    if face_route is None:
+        return v, f, None
+    route = np.asarray(face_route, dtype=np.int64).ravel()
+    if route.shape != (len(mesh_f),) or (len(route) and not 0 <= route.min() <= route.max()
+                                         < len(routes)):
+        raise InvalidParameterError(
+            f"face_route must give each of the {len(mesh_f)} faces an index into routes "
+            f"{tuple(routes)}")
+    table = np.array([ROUTE_COLOURS.get(r, _MESH_COLOUR) for r in routes], dtype=np.float64)
+    return v, f, table[route[index]].reshape(-1, 3)
+
+
+def _legend(fig, routes, wires: bool) -> None:
+    """Route names (and "wires") in their colours along the picture's bottom edge."""
+    names = [(r, ROUTE_COLOURS.get(r, _MESH_COLOUR)) for r in routes]
+    names += [("wires", WIRE_COLOUR)] if wires else []
+    for k, (name, colour) in enumerate(names):
+        fig.text(0.01 + 0.12 * k, 0.01, "\u25a0 " + name, color=colour, fontsize=10,
+                 fontweight="bold")
 
 
 @dataclass
@@ -436,9 +480,12 @@ class _Scene:
     mesh_tris: np.ndarray | None    # (F, 3, 3)
     lo: np.ndarray              # (3,) bounding box of all of it
     hi: np.ndarray
+    mesh_rgb: np.ndarray | None     # (F, 3) per-face colour (routes), else one colour
+    wires: list                 # polylines beside the surface, (n, 3) each
 
     @classmethod
-    def build(cls, rot, lines, line_colours, network, hl_edges, fans, mesh_v, mesh_f):
+    def build(cls, rot, lines, line_colours, network, hl_edges, fans, mesh_v, mesh_f,
+              mesh_rgb=None, wires=()):
         """Rotate by ``rot`` (3, 3) and bound; raises when there is nothing to draw."""
         net_curves = [] if network is None else [e.curve for e in network.edges]
         net_colours = [] if network is None else [
@@ -449,11 +496,12 @@ class _Scene:
         hl_edges = [x @ rot for x in hl_edges]
         net_curves = [x @ rot for x in net_curves]
         net_pos = net_pos @ rot
+        wires = [x @ rot for x in wires]
         tris, rgb, amb = fans
         tris = [t @ rot for t in tris]
         if mesh_v is not None:
             mesh_v = mesh_v @ rot
-        pts = [np.zeros((0, 3)), net_pos] + lines + hl_edges + net_curves
+        pts = [np.zeros((0, 3)), net_pos] + lines + hl_edges + net_curves + wires
         if mesh_v is not None:
             pts.append(mesh_v[np.unique(mesh_f)])
         pts = np.concatenate(pts)
@@ -465,7 +513,7 @@ class _Scene:
                    np.concatenate(rgb) if rgb else None,
                    np.concatenate(amb) if amb else None,
                    None if mesh_v is None else mesh_v[mesh_f],
-                   pts.min(axis=0), pts.max(axis=0))
+                   pts.min(axis=0), pts.max(axis=0), mesh_rgb, wires)
 
 
 def _figure(scene: _Scene, views, width: int, height: int, title):
@@ -493,7 +541,9 @@ def _draw_panel(ax, scene: _Scene, light):
 
     if scene.mesh_tris is not None:
         ax.add_collection3d(Poly3DCollection(
-            scene.mesh_tris, facecolors=_shade(scene.mesh_tris, _MESH_COLOUR, light),
+            scene.mesh_tris,
+            facecolors=_shade(scene.mesh_tris,
+                              _MESH_COLOUR if scene.mesh_rgb is None else scene.mesh_rgb, light),
             edgecolors="none", linewidths=0, antialiased=False, zorder=1))
     if scene.patch_tris is not None:
         ax.add_collection3d(Poly3DCollection(
@@ -508,6 +558,9 @@ def _draw_panel(ax, scene: _Scene, light):
                                              linewidths=1.2, zorder=5))
         pos = scene.net_pos
         ax.scatter(pos[:, 0], pos[:, 1], pos[:, 2], s=4, c="k", depthshade=False, zorder=6)
+    if scene.wires:
+        ax.add_collection3d(Line3DCollection(scene.wires, colors=[WIRE_COLOUR],
+                                             linewidths=1.6, zorder=5))
     if scene.hl_edges:
         ax.add_collection3d(Line3DCollection(scene.hl_edges, colors=[HIGHLIGHT_COLOUR],
                                              linewidths=3.0, zorder=7))

@@ -175,3 +175,46 @@ def test_import_is_light():
             "bad = [m for m in ('matplotlib', 'torch') if m in sys.modules]; "
             "sys.exit(1 if bad else 0)")
     assert subprocess.run([sys.executable, "-c", code]).returncode == 0
+
+
+def test_faces_coloured_by_route_and_wires_drawn(tmp_path):
+    from curvenet.preview import ROUTE_COLOURS, WIRE_COLOUR
+    a = trimesh.creation.icosphere(subdivisions=3)
+    b = a.copy()
+    b.vertices += [3.0, 0.0, 0.0]
+    both = trimesh.util.concatenate([a, b])
+    route = np.r_[np.zeros(len(a.faces), int), np.ones(len(b.faces), int)]
+    wire = np.c_[np.linspace(0, 3, 20), np.zeros(20), np.full(20, 1.5)]
+    kw = dict(mesh=both, size=(500, 300), view=(20, -90))
+    plain = read_png(render_preview(tmp_path / "plain.png", **kw))
+    routed = read_png(render_preview(tmp_path / "routed.png", face_route=route,
+                                     routes=("classical", "neural"), wires=[wire], **kw))
+
+    def hue_share(img, rgb):
+        # shaded faces keep the hue: the colour's channel order (warm vs cool)
+        warm = np.asarray(rgb)[0] > np.asarray(rgb)[2]
+        d = img[..., 0] - img[..., 2]
+        return float(np.mean((d > 0.15) if warm else (d < -0.15)))
+
+    assert hue_share(plain, ROUTE_COLOURS["neural"]) == 0.0
+    assert hue_share(routed, ROUTE_COLOURS["neural"]) > 0.02
+    assert hue_share(routed, ROUTE_COLOURS["classical"]) > 0.02
+    # the neural sphere (x = 3) is the right one in this view: warm pixels lie right
+    warm = (routed[..., 0] - routed[..., 2]) > 0.15
+    cols = np.flatnonzero(warm.any(axis=0))
+    assert np.median(cols) > routed.shape[1] / 2
+    assert count_colour(routed, WIRE_COLOUR, tol=0.05) > 20
+    with pytest.raises(InvalidParameterError, match="face_route"):
+        render_preview(tmp_path / "bad.png", face_route=route[:-1], routes=("classical",),
+                       **kw)
+
+
+def test_decimation_index_names_the_source_faces():
+    m = trimesh.creation.icosphere(subdivisions=5)
+    v, f, index = decimate_clustering(m.vertices, m.faces, 2000, return_index=True)
+    assert len(index) == len(f) <= 2000
+    # each output face lies where its source face was (within a clustering cell ~ 0.06)
+    moved = np.linalg.norm(v[f].mean(axis=1) - m.triangles_center[index], axis=1)
+    assert moved.max() < 0.15
+    _v, small_f, same = decimate_clustering(m.vertices, m.faces[:50], 2000, return_index=True)
+    np.testing.assert_array_equal(same, np.arange(50))
