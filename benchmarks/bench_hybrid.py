@@ -71,9 +71,15 @@ def main() -> None:
                 fh.write("\t".join(str(row[c]) for c in COLUMNS) + "\n")
             print("\t".join(str(row[c]) for c in COLUMNS), flush=True)
     rows = [line.split("\t") for line in out.read_text().splitlines()[1:]]
-    ok = [float(r[5]) for r in rows if r[5] != "-"]
+    ok = [r for r in rows if r[5] != "-"]
     if ok:
-        print(f"# {len(ok)} sketches: with wires >= 85% on {np.sum(np.array(ok) >= 0.85)}")
+        both, wires = (np.array([float(r[k]) for r in ok]) for k in (5, 6))
+        surf = np.array([float(r[4]) for r in ok])
+        print(f"# {len(ok)} sketches ({len(rows) - len(ok)} errors): with wires >= 85% on "
+              f"{np.sum(both >= 0.85)}, median {np.median(both):.1%}, min {both.min():.1%}; "
+              f"surface alone median {np.median(surf):.1%}, min {surf.min():.1%}; "
+              f"wires carry at most {wires.max():.1%}; "
+              f"{sum(float(r[3]) for r in ok):.1f} s in all")
 
 
 if __name__ == "__main__":

@@ -3,8 +3,10 @@
 The tiles are the small pictures :func:`curvenet.batch.run_batch` writes into the preview
 folder (rendered by :func:`curvenet.preview.render_preview` on the workers). Each tile's
 frame and caption are coloured by the route the file took (:data:`ROUTE_COLOURS`), so a
-mixed batch shows at a glance which files went classical and which neural; failed files
-get a red, empty tile with the error's first words.
+mixed batch shows at a glance which files went classical, neural or hybrid; inside a
+tile the faces are coloured by the route that made them and the wires drawn
+(:data:`curvenet.preview.ROUTE_COLOURS`). Failed files get a red, empty tile with the
+error's first words.
 """
 
 from __future__ import annotations
@@ -19,7 +21,7 @@ __all__ = ["contact_sheet", "ROUTE_COLOURS"]
 
 #: Frame colour per route (the part of ``route`` before any ``+``) and for failures.
 ROUTE_COLOURS = {"classical": "#1f4e9c", "soapfilm": "#2a8a4a", "neural": "#d9730d",
-                 "failed": "#c0262d"}
+                 "hybrid": "#7b3fa0", "failed": "#c0262d"}
 
 #: Tile width and height in inches at 100 dpi, and the number of columns at most.
 TILE_INCHES, MAX_COLUMNS = (2.4, 2.3), 6

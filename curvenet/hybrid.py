@@ -2,8 +2,8 @@
 
 The curves no patch uses are grouped into *regions*: curves closer to each other than
 :data:`REGION_GAP` of the network's diagonal belong together. A region whose curves
-span area (seen in the plane of its two main directions, most of its bounding
-rectangle lies near a curve, and the rectangle is not a sliver) is *surface-like* and
+span area (seen in the plane of its two main directions, most of its convex hull
+lies near a curve, and its bounding rectangle is not a sliver) is *surface-like* and
 gets a neural fill when it carries at least :data:`MIN_FILL_LENGTH` of the curve length;
 any other region (a single stroke, legs, a stem, a small detail) stays as wires.
 :func:`plan_regions` makes that decision as data; :func:`trim_fill` keeps of a
@@ -29,12 +29,12 @@ __all__ = ["REGION_GAP", "plan_regions", "region_strokes", "trim_fill", "assembl
 
 #: curves closer than this fraction of the network's diagonal form one region
 REGION_GAP = 0.08
-#: a region is surface-like when at least this share of its 2D bounding rectangle
-#: lies within REGION_GAP of one of its curves...
+#: a region is surface-like when at least this share of its 2D convex hull
+#: lies within REGION_GAP / 2 of one of its curves...
 FILL_SHARE = 0.7
-#: ...and the rectangle's short side is at least this fraction of its long side
+#: ...and its bounding rectangle's short side is at least this fraction of its long side
 MIN_SPREAD = 0.15
-#: grid cells per side of the rectangle probed for the fill share
+#: grid points per side of the bounding rectangle probed (inside the hull) for the fill share
 FILL_GRID = 16
 #: a surface-like region gets a neural fill only when it carries at least this share of
 #: the network's curve length: a fill costs a whole neural fit, and a smaller region
@@ -62,18 +62,26 @@ def _groups(curves, ids, gap: float) -> list:
 
 
 def _fill_share(points: np.ndarray, gap: float) -> tuple[float, float]:
-    """(share of the PCA bounding rectangle within ``gap`` of a point, short/long side)."""
+    """(share of the 2D convex hull within ``gap`` of a point, short/long side).
+
+    The points are seen in the plane of their two main directions; the hull (not the
+    bounding rectangle, whose corners a round region never reaches) is probed on a
+    grid. The side ratio is that of the PCA bounding rectangle; below
+    :data:`MIN_SPREAD` the share is not measured (0).
+    """
+    from scipy.spatial import ConvexHull, Delaunay
     centred = points - points.mean(axis=0)
     _u, _s, vt = np.linalg.svd(centred, full_matrices=False)
     flat = centred @ vt[:2].T
     lo, hi = flat.min(axis=0), flat.max(axis=0)
     side = hi - lo
-    if not side[0] > 0:
-        return 0.0, 0.0
+    if not side[0] > 0 or side[1] < MIN_SPREAD * side[0]:
+        return 0.0, float(side[1] / side[0]) if side[0] > 0 else 0.0
     g = np.stack(np.meshgrid(*[np.linspace(lo[k], hi[k], FILL_GRID) for k in (0, 1)]),
                  axis=-1).reshape(-1, 2)
+    g = g[Delaunay(flat[ConvexHull(flat).vertices]).find_simplex(g) >= 0]
     near = cKDTree(flat).query(g)[0] < gap
-    return float(np.mean(near)), float(side[1] / side[0])
+    return float(np.mean(near)) if len(g) else 0.0, float(side[1] / side[0])
 
 
 def plan_regions(curves, used, *, gap_rel: float = REGION_GAP) -> list:

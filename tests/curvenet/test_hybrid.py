@@ -181,3 +181,24 @@ def test_an_overdrawn_stroke_the_surface_misses_is_kept_as_a_wire(tmp_path):
     assert fid["with_wires"] == 1.0 and 0 < fid["wire_share"] < 0.1
     res.save(tmp_path / "box.obj")
     np.testing.assert_allclose(read_obj_wires(tmp_path / "box.obj")[0], guest, atol=1e-8)
+
+
+def test_a_round_plate_of_strokes_is_surface_like():
+    """An oval rim with strokes across it: most of its hull lies near a stroke, though the
+    corners of its bounding rectangle (which an oval never reaches) do not."""
+    from curvenet.hybrid import FILL_SHARE, REGION_GAP
+    u = np.linspace(0, 2 * np.pi, 200)
+    rim = np.c_[np.cos(u), 0.8 * np.sin(u), 0 * u]
+    chords = [np.c_[np.linspace(-1, 1, 30) * np.sqrt(1 - (y / 0.8) ** 2), 0 * T[:30] + y,
+                    0 * T[:30]] for y in np.linspace(-0.457, 0.457, 4)]
+    curves = [rim] + chords
+    (region,) = plan_regions(curves, np.zeros(5, bool))
+    assert region["route"] == "neural" and region["fill"] >= FILL_SHARE
+    # the bounding rectangle alone would have judged it a set of wires
+    gap = REGION_GAP * np.linalg.norm(np.ptp(np.concatenate(curves), axis=0)) / 2
+    g = np.stack(np.meshgrid(np.linspace(-1, 1, 16), np.linspace(-0.8, 0.8, 16)),
+                 axis=-1).reshape(-1, 2)
+    from curvenet.core.geometry import densify_polyline
+    dense = np.concatenate([densify_polyline(c, gap / 8) for c in curves])[:, :2]
+    from scipy.spatial import cKDTree
+    assert np.mean(cKDTree(dense).query(g)[0] < gap) < FILL_SHARE
