@@ -71,6 +71,9 @@ class PatchMeshResult(MeshResult):
     control_net : surfacing.bspline.ControlNet or None
         The fitted control mesh with its patches, creases and curves, for B-spline
         export (classical route only).
+    curve_vertices : list of (k_c,) int64 or None
+        Per input curve, the output vertex ids along it from its first point to its
+        last (None for a curve no loop uses); None when the route has none.
     """
 
     face_patch: np.ndarray
@@ -78,6 +81,7 @@ class PatchMeshResult(MeshResult):
     control_vertices: np.ndarray | None = None
     control_quads: np.ndarray | None = None
     control_net: ControlNet | None = None
+    curve_vertices: list | None = None
 
 
 def _quads_to_tris(q: np.ndarray) -> np.ndarray:
@@ -266,8 +270,11 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
                      crease=crease, detected=detected, n_faces=len(faces),
                      resolution=resolution, subdiv=int(subdiv))
     net = ControlNet(P, cm.quads, cm.face_patch, *sharp, list(cm.curve_vids), cm.diagonal)
+    used = {ci for lp in cm.loops for ci, _ in lp}
     return PatchMeshResult(V, faces, report, face_patch=face_patch, curves=new_curves,
-                           control_vertices=P, control_quads=cm.quads, control_net=net)
+                           control_vertices=P, control_quads=cm.quads, control_net=net,
+                           curve_vertices=[ch if c in used else None
+                                           for c, ch in enumerate(chains)])
 
 
 def _build(curves, loops, resolution, crease_curves, crease_angle, straight_angle):

@@ -10,11 +10,9 @@ a simple loop. The
 regions are surfaced by :func:`surfacing.surface_loops` like any loop, and
 report as one patch (``face_patch``) with their face.
 
-Planar boundaries give planar surfaces: every patch whose boundary curves lie
-in a plane (within :data:`FLAT_TOL` of the diagonal) has its output vertices
-put in that plane (a vertex shared by several such patches on the intersection
-of their planes); a Coons patch of a planar boundary is planar already, so this
-removes only what the fairness across the boundary pulled out of the plane.
+Flat patches (boundary in a plane, holes or not) are surfaced over their outer
+loop only and then meshed in their plane (:mod:`surfacing.flat`); the sector
+cuts are for faces with holes that are not flat.
 """
 
 from __future__ import annotations
@@ -23,10 +21,9 @@ import numpy as np
 
 from curvenet.core.geometry import fit_plane
 
-__all__ = ["split_holed", "split_boundaries", "flatten_planar", "surface_boundaries", "FLAT_TOL"]
+from .flat import FLAT_TOL, flat_planes, flatten_planar, loop_points, mesh_flat
 
-#: A patch is flat when its boundary points lie this close to a plane (fraction of the diagonal).
-FLAT_TOL = 1e-6
+__all__ = ["split_holed", "split_boundaries", "surface_boundaries", "UnsplittableFace"]
 
 
 def _start(curves, item):
@@ -34,10 +31,6 @@ def _start(curves, item):
     return curves[c][0] if f else curves[c][-1]
 
 
-
-
-def _loop_points(curves, loop):
-    return np.concatenate([(curves[c] if f else curves[c][::-1])[:-1] for c, f in loop])
 
 
 def _cross2(a, b):
@@ -52,9 +45,9 @@ def _crosses(p, q, a, b, eps):
 
 
 def _frame(curves, boundary):
-    pts = np.concatenate([_loop_points(curves, lp) for lp in boundary])
+    pts = np.concatenate([loop_points(curves, lp) for lp in boundary])
     c, _, _ = fit_plane(pts)
-    outer = _loop_points(curves, boundary[0])
+    outer = loop_points(curves, boundary[0])
     n = np.cross(outer, np.roll(outer, -1, axis=0)).sum(axis=0)
     n /= np.linalg.norm(n)
     e1 = np.linalg.svd(pts - c, full_matrices=False)[2][0]
@@ -145,7 +138,7 @@ def split_holed(curves, boundary, first_new: int, samples: int = 17):
     loop_of = np.concatenate([np.full(len(lp), k) for k, lp in enumerate(boundary)])
     j3 = np.array([_start(curves, it) for it in items])
     j2 = (j3 - c) @ axes.T
-    polys = [(_loop_points(curves, lp) - c) @ axes.T for lp in boundary]
+    polys = [(loop_points(curves, lp) - c) @ axes.T for lp in boundary]
     seg_a = np.concatenate(polys)
     seg_b = np.concatenate([np.roll(p, -1, axis=0) for p in polys])
     scale = float(np.ptp(seg_a, axis=0).max())
@@ -245,65 +238,6 @@ def split_boundaries(curves, boundaries, samples: int = 17):
     return curves, loops, np.asarray(owner, dtype=np.int64), unsplit
 
 
-def flatten_planar(vertices, faces, face_patch, curves, boundaries, tol: float = FLAT_TOL):
-    """Put the output vertices of every flat patch in its plane.
-
-    Parameters
-    ----------
-    vertices : (n, 3) float64
-    faces : (f, 3) int64
-    face_patch : (f,) int64
-        Patch of each face (index into ``boundaries``).
-    curves : list of (m_i, 3) float64
-    boundaries : list of list of list of (int, bool)
-    tol : float
-        Flatness of a boundary, fraction of the curves' bounding-box diagonal.
-
-    Returns
-    -------
-    vertices : (n, 3) float64
-        A copy; a vertex of several flat patches lands on the intersection of
-        their planes nearest to it (least squares).
-    flat : (len(boundaries),) bool
-        Which patches are flat.
-    """
-    allpts = np.concatenate([np.asarray(c, float) for c in curves])
-    diag = float(np.linalg.norm(np.ptp(allpts, axis=0))) or 1.0
-    normals = np.zeros((len(boundaries), 3))
-    offsets = np.zeros(len(boundaries))
-    flat = np.zeros(len(boundaries), bool)
-    for k, b in enumerate(boundaries):
-        pts = np.concatenate([_loop_points(curves, lp) for lp in b])
-        c, n, _ = fit_plane(pts)
-        flat[k] = np.abs((pts - c) @ n).max() <= tol * diag
-        normals[k], offsets[k] = n, n @ c
-    V = np.array(vertices, dtype=np.float64)
-    fp = np.asarray(face_patch)
-    sel = flat[fp]
-    if not sel.any():
-        return V, flat
-    import scipy.sparse as sp
-    f, p = np.asarray(faces)[sel], fp[sel]
-    inc = sp.csr_matrix((np.ones(f.size), (f.ravel(), np.repeat(p, 3))),
-                        shape=(len(V), len(boundaries)))
-    inc.data[:] = 1.0
-    inc.sum_duplicates()
-    inc.data[:] = 1.0
-    rows = np.flatnonzero(np.diff(inc.indptr))
-    counts = np.diff(inc.indptr)[rows]
-    K = int(counts.max())
-    N = np.zeros((len(rows), K, 3))
-    d = np.zeros((len(rows), K))
-    slot = np.arange(inc.nnz) - np.repeat(inc.indptr[rows], counts)
-    r = np.repeat(np.arange(len(rows)), counts)
-    N[r, slot], d[r, slot] = normals[inc.indices], offsets[inc.indices]
-    x = V[rows]
-    resid = np.einsum("mkj,mj->mk", N, x) - d
-    G = np.linalg.pinv(np.einsum("mkj,mlj->mkl", N, N))
-    V[rows] = x - np.einsum("mkj,mkl,ml->mj", N, G, resid)
-    return V, flat
-
-
 def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: float = FLAT_TOL,
                        **options):
     """:func:`surfacing.surface_loops` for patches that may have holes; flat patches flat.
@@ -316,7 +250,9 @@ def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: f
     cut_samples : int
         Points per cut polyline.
     flat_tol : float
-        See :func:`flatten_planar`.
+        Flatness of a boundary, fraction of the diagonal (:func:`surfacing.flat.flat_planes`):
+        flat patches are surfaced over their outer loop, then meshed in their plane
+        (:func:`surfacing.flat.mesh_flat`).
     **options
         Passed to :func:`surfacing.surface_loops` (``crease_curves``, ``resolution``, ...).
 
@@ -324,20 +260,29 @@ def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: f
     -------
     PatchMeshResult
         ``face_patch`` indexes ``boundaries``; ``report`` adds ``n_sectors``
-        (loops surfaced), ``cuts`` and ``flat_patches``; ``curves`` (when asked
-        for) holds the input curves only.
+        (loops surfaced), ``cuts``, ``flat_patches``, ``flat_meshed`` (those meshed
+        in-plane) and ``unsplit_holes``; ``curves`` (when asked for) holds the input
+        curves only.
     """
     from . import surface_loops     # the package's, so a patched one is the one called
-    from .api import PatchMeshResult
+    from .api import DEFAULT_EDGE_LENGTH, DEFAULT_MAX_FACES, PatchMeshResult
     n = len(curves)
-    all_curves, loops, owner, unsplit = split_boundaries(curves, boundaries, cut_samples)
+    flat, normals, offsets = flat_planes(curves, boundaries, flat_tol)
+    outer_only = [b[:1] if f else b for b, f in zip(boundaries, flat)]
+    all_curves, loops, owner, unsplit = split_boundaries(curves, outer_only, cut_samples)
     res = surface_loops(all_curves, loops, **options)
     face_patch = owner[res.face_patch]
-    V, flat = flatten_planar(res.vertices, res.faces, face_patch, curves, boundaries, flat_tol)
+    V = flatten_planar(res.vertices, res.faces, face_patch, flat, normals, offsets)
+    auto = options.get("subdiv") is None
+    target = options.get("edge_length", DEFAULT_EDGE_LENGTH) * res.control_net.diagonal
+    V, F, face_patch, meshed = mesh_flat(
+        V, res.faces, face_patch, res.curve_vertices, curves, boundaries, flat, normals,
+        offsets, edge_length=target if auto else None,
+        max_faces=max(DEFAULT_MAX_FACES, len(res.faces)) if auto else None)
     report = dict(res.report, n_patches=len(boundaries), n_sectors=len(loops),
                   cuts=len(all_curves) - n, flat_patches=int(flat.sum()),
-                  unsplit_holes=unsplit)
+                  flat_meshed=int(meshed.sum()), n_faces=len(F), unsplit_holes=unsplit)
     new_curves = None if res.curves is None else res.curves[:n]
-    return PatchMeshResult(V, res.faces, report, face_patch=face_patch, curves=new_curves,
+    return PatchMeshResult(V, F, report, face_patch=face_patch, curves=new_curves,
                            control_vertices=res.control_vertices,
                            control_quads=res.control_quads, control_net=res.control_net)
