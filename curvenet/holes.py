@@ -8,7 +8,11 @@ is the sum of its boundary cycles; geometry decides which sum is meant:
 * an *inner* patch whose loop lies in the plane of a planar *outer* patch,
   strictly inside its outline and sharing no junction with it, is a hole of
   the innermost such outer patch (the outer patch becomes a
-  :class:`~curvenet.patchset.Patch` with ``holes``);
+  :class:`~curvenet.patchset.Patch` with ``holes``), provided the outer patch
+  lies on a manifold stretch of the surface (none of its curves is shared by
+  three or more patches): a flat fin or plate attached where other surfaces
+  meet is a sheet, with no solid behind it for a hole to open into, and a
+  loop drawn on it (the base of a fin standing on it) stays a disc;
 * the inner patch itself is dropped when a wall continues through its loop
   (every one of its curves is also used by another patch: a bore, a boss),
   and kept as a disc when nothing does (a face drawn inside a face).
@@ -65,6 +69,10 @@ def hole_patches(network: CurveNetwork, patches, *, plane_tol: float = PLANE_TOL
         planar = not p.holes and float(np.abs((pts - c) @ nrm).max()) <= tol
         verts = {network.edges[e].u for e in p.edges} | {network.edges[e].v for e in p.edges}
         info.append((pts, c, nrm, axes, planar, verts))
+    uses = np.zeros(network.number_of_edges, dtype=np.int64)
+    for p in patches:
+        uses[list(p.edges)] += 1
+    manifold = [bool((uses[list(p.edges)] <= 2).all()) for p in patches]
     parent = {}
     for i in range(n):
         pi, _, _, _, planar_i, vi = info[i]
@@ -73,7 +81,7 @@ def hole_patches(network: CurveNetwork, patches, *, plane_tol: float = PLANE_TOL
         best = None
         for j in range(n):
             pj, cj, nj, aj, planar_j, vj = info[j]
-            if j == i or not planar_j or vi & vj:
+            if j == i or not planar_j or not manifold[j] or vi & vj:
                 continue
             if float(np.abs((pi - cj) @ nj).max()) > tol:
                 continue
@@ -85,9 +93,6 @@ def hole_patches(network: CurveNetwork, patches, *, plane_tol: float = PLANE_TOL
                 best = (area, j)
         if best is not None:
             parent[i] = best[1]
-    uses = np.zeros(network.number_of_edges, dtype=np.int64)
-    for p in patches:
-        uses[list(p.edges)] += 1
     holes: dict = {}
     dropped = set()
     for i, j in sorted(parent.items()):

@@ -107,6 +107,42 @@ def test_a_disc_drawn_inside_a_face_is_kept():
     assert report == [] and all(not p.holes for p in patches)
 
 
+def test_a_loop_on_a_sheet_where_surfaces_meet_stays_a_disc():
+    """The square shares a side with two more patches (a fin where three surfaces meet):
+    it is a sheet, not a solid's face, so the circle on it (a fin base) is no hole."""
+    from curvenet.network import CurveNetwork
+    net = CurveNetwork(np.zeros((0, 3)))
+    sq = [net.add_vertex(p) for p in ([0, 0, 0], [2, 0, 0], [2, 2, 0], [0, 2, 0])]
+    t = np.linspace(0, 1, 17)[:, None]
+
+    def straight(a, b):
+        return net.add_edge(a, b, (1 - t) * net.positions[a] + t * net.positions[b])
+    outer = [straight(a, b) for a, b in zip(sq, sq[1:] + sq[:1])]
+    c = [net.add_vertex(p) for p in ([1.5, 1, 0], [0.5, 1, 0])]
+    a = np.pi * t
+    inner = [net.add_edge(c[0], c[1], np.c_[1 + 0.5 * np.cos(a), 1 + 0.5 * np.sin(a), 0 * a]),
+             net.add_edge(c[1], c[0], np.c_[1 - 0.5 * np.cos(a), 1 - 0.5 * np.sin(a), 0 * a])]
+    fins = []
+    for z in (1.0, -1.0):
+        apex = net.add_vertex([1, -0.5, z])
+        fins.append(Patch([outer[0], straight(sq[1], apex), straight(apex, sq[0])]))
+    patches, report = hole_patches(net, [Patch(outer), Patch(inner), *fins])
+    assert report == [] and all(not p.holes for p in patches)
+    # with one fin the square's sides are manifold again: the circle is a hole
+    patches, report = hole_patches(net, [Patch(outer), Patch(inner), fins[0]])
+    assert [p.holes for p in patches] == [(tuple(inner),), (), ()]
+
+
+@pytest.mark.data
+def test_submarine_fin_base_stays_a_disc(data_dir):
+    """mingzou/SGA_Submarine: a fin stands on a flat plate attached along a curve shared by
+    three patches; its base stays a disc (43 patches, as without hole detection)."""
+    from curvenet.pipeline import patches
+    f = data_dir / "networks" / "mingzou" / "SGA_Submarine.obj"
+    ps = patches(f)
+    assert len(ps.patches) == 43 and ps.report["holes"] == []
+
+
 def test_patches_json_keeps_holes(tmp_path):
     s = shapes.washer()
     ps = find_patches(s.network)
