@@ -77,6 +77,7 @@ class BatchOptions:
     subdiv: int | None = None
     resolution: int | None = None
     crease_angle: float = 30.0
+    edge_length: float | None = None
     refine: bool = False
     quality: str = "draft"
     device: str = "cpu"
@@ -175,6 +176,8 @@ def _surface_file(local: str, options: BatchOptions, tmp: str, *, preview, tile,
                   resolution=options.resolution, crease_angle=options.crease_angle,
                   refine=options.refine, quality=options.quality, device=options.device,
                   seed=options.seed, progress=False,
+                  classical_options=(None if options.edge_length is None
+                                     else {"edge_length": options.edge_length}),
                   neural_options=dict(options.neural_options) or None,
                   points=True if options.points else "auto")
     out: dict = {f"t_{k}": float(v) for k, v in res.timings.items()}

@@ -55,6 +55,22 @@ def _positive_int(text: str) -> int:
     return value
 
 
+def _edge_length(text: str) -> float:
+    """``--edge-length``: a fraction of the diagonal in (0, 1]."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not 0.0 < value <= 1.0:
+        raise argparse.ArgumentTypeError(f"{text} is not a fraction in (0, 1]")
+    return value
+
+
+def _classical_options(args) -> dict | None:
+    """Options of the classical surfacer from the command line."""
+    return None if args.edge_length is None else {"edge_length": args.edge_length}
+
+
 def _seed(text: str) -> int:
     try:
         value = int(text)
@@ -141,7 +157,11 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--points", action="store_true", help=_POINTS_HELP)
     s.add_argument("--surfacer", choices=surfacer_names("patches"), default="catmull-clark",
                    help="surfacer of the classical route (default catmull-clark)")
-    s.add_argument("--subdiv", type=_positive_int, help="Catmull-Clark levels")
+    density = s.add_mutually_exclusive_group()
+    density.add_argument("--subdiv", type=_positive_int, help="Catmull-Clark levels")
+    density.add_argument("--edge-length", type=_edge_length, metavar="F",
+                         help="classical: target output edge length, fraction of the bbox "
+                              "diagonal (default 0.005; at most 200k triangles)")
     s.add_argument("--resolution", type=_positive_int, help="Coons samples per side segment")
     s.add_argument("--crease-angle", type=float, default=30.0, metavar="DEG")
     s.add_argument("--refine", action="store_true",
@@ -240,6 +260,7 @@ def _surface_one(inp: str, out: str, args) -> dict:
                       resolution=args.resolution, crease_angle=args.crease_angle,
                       refine=args.refine, quality=args.quality, device=args.device,
                       seed=args.seed, progress=not args.no_progress,
+                      classical_options=_classical_options(args),
                       neural_options=_neural_options(args), points=_points(args))
         res.save(out, schema=args.step_schema)
         if args.preview:
@@ -335,8 +356,9 @@ def _batch_options(args):
     from .batch import BatchOptions
     return BatchOptions(method=args.method, snap_tol=args.snap_tol, close=args.close,
                         surfacer=args.surfacer, subdiv=args.subdiv, resolution=args.resolution,
-                        crease_angle=args.crease_angle, refine=args.refine,
-                        quality=args.quality, device=args.device, seed=args.seed,
+                        crease_angle=args.crease_angle, edge_length=args.edge_length,
+                        refine=args.refine, quality=args.quality, device=args.device,
+                        seed=args.seed,
                         neural_options=tuple(sorted((_neural_options(args) or {}).items())),
                         format=args.format, points=args.points)
 

@@ -171,3 +171,35 @@ def test_snap_and_explain_print_the_snapping_line(tmp_path):
     r = run("surface", rough, "-o", tmp_path / "s.obj", "--method", "classical", "--explain")
     assert r.returncode == 0, r.stderr
     assert any(x.startswith("snap: tolerance") for x in r.stdout.splitlines())
+
+
+def test_edge_length_sets_the_output_density(tmp_path, box_obj):
+    """--edge-length F: output edges of about F of the diagonal, one file or a batch."""
+    diag = np.sqrt(3.0)
+    faces = {}
+    for f in (0.05, 0.01):
+        out = tmp_path / f"m{f}.obj"
+        assert main(["surface", str(box_obj), "-o", str(out), "--method", "classical",
+                     "--edge-length", str(f)]) == 0
+        m = trimesh.load(out, force="mesh", process=False)
+        assert 0.4 * f * diag < np.median(m.edges_unique_length) < 1.2 * f * diag
+        faces[f] = len(m.faces)
+    assert faces[0.01] > 10 * faces[0.05]
+    assert main(["surface", str(box_obj), "--out-dir", str(tmp_path / "b"), "--method",
+                 "classical", "--edge-length", "0.05", "--no-progress"]) == 0
+    batch = trimesh.load(next((tmp_path / "b").glob("*.obj")), force="mesh", process=False)
+    assert len(batch.faces) == faces[0.05]
+
+
+@pytest.mark.parametrize("argv,match", [(["--edge-length", "0"], "(0, 1]"),
+                                        (["--edge-length", "1.5"], "(0, 1]"),
+                                        (["--edge-length", "fine"], "not a number"),
+                                        (["--edge-length", "0.01", "--subdiv", "2"],
+                                         "not allowed")])
+def test_bad_edge_length_is_one_clear_error(tmp_path, box_obj, capsys, argv, match):
+    with pytest.raises(SystemExit) as exc:
+        main(["surface", str(box_obj), "-o", str(tmp_path / "m.obj"), *argv])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert "--edge-length" in err and match in err
+    assert not (tmp_path / "m.obj").exists()
