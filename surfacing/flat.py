@@ -212,13 +212,12 @@ def mesh_flat(vertices, faces, face_patch, chains, curves, boundaries, flat, nor
                                  boundaries, todo)
     frames = [_plane_frame(V, _rings(boundaries[k], chains), normals[k]) for k in todo]
     budget = None if max_faces is None else max_faces - int((~flat[FP]).sum())
-    spacing = _spacings(frames, edge_length, budget)
+    cdts = _cdts(frames, _spacings(frames, edge_length, budget), budget)
     meshed = np.zeros(len(boundaries), bool)
     keep = np.ones(len(F), bool)
     new_v, new_f, new_p = [], [], []
     n_next = len(V)
-    for k, fr, h in zip(todo, frames, spacing):
-        got = None if fr is None else _triangulate(fr["xy"], fr["rings"], h)
+    for k, fr, got in zip(todo, frames, cdts):
         if got is None:
             continue
         P, T = got
@@ -241,6 +240,19 @@ def mesh_flat(vertices, faces, face_patch, chains, curves, boundaries, flat, nor
     used[F.ravel()] = True
     remap = np.cumsum(used) - 1
     return V[used], remap[F], FP, meshed
+
+
+def _cdts(frames, spacing, budget, tries: int = 3):
+    """:func:`_triangulate` of every frame (None where it has none); while the triangles
+    exceed ``budget`` (an estimate from the areas can fall short), coarser again."""
+    for _ in range(tries):
+        got = [None if fr is None else _triangulate(fr["xy"], fr["rings"], h)
+               for fr, h in zip(frames, spacing)]
+        total = sum(len(g[1]) for g in got if g is not None)
+        if budget is None or total <= budget:
+            break
+        spacing = spacing * 1.05 * np.sqrt(total / max(budget, 1))
+    return got
 
 
 def _plane_frame(V, rings, normal):

@@ -234,3 +234,12 @@ def test_a_face_no_cut_can_split_is_surfaced_over_its_outer_loop(monkeypatch):
     curves, loops, owner, unsplit = sh.split_boundaries([outer, inner], boundaries)
     assert unsplit == [1] and len(curves) == 2
     assert loops == [[(0, True)], [(0, True)]] and owner.tolist() == [0, 1]
+
+
+def test_many_flat_faces_stay_under_the_default_face_cap():
+    """A flange with 12 bolt holes (58 patches, ABC-sized): the in-plane meshes of its two
+    large flat faces are coarsened until the whole output fits in 200k triangles."""
+    s = shapes.flange(bolts=12)
+    res = _classical(s)
+    assert len(res.patchset.patches) == 58
+    assert 150_000 < len(res.mesh.faces) <= 200_000
