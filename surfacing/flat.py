@@ -37,9 +37,8 @@ def flat_planes(curves, boundaries, tol: float = FLAT_TOL):
 
     Parameters
     ----------
-    curves : list of (m_i, 3) float64
-    boundaries : list of list of list of (int, bool)
-        Per patch ``[outer, hole_1, ...]`` loops of (curve index, forward).
+    curves, boundaries
+        As for :func:`surfacing.holes.surface_boundaries`.
     tol : float
         Flatness of a boundary, fraction of the curves' bounding-box diagonal.
 
