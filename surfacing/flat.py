@@ -134,8 +134,8 @@ _MERGED = 1e-9
 def _triangulate(xy, rings, spacing):
     """Quality CDT of the loops ``rings`` (index arrays into ``xy``, outer first) keeping
     every boundary vertex and segment; returns (vertices (m, 2), triangles (t, 3)) with
-    the inputs first, or None when two boundary vertices (nearly) coincide or a boundary
-    segment is lost (crossing loops).
+    the inputs first, or None when two boundary vertices (nearly) coincide or loops cross
+    (Triangle fails, or splits a boundary segment).
 
     A first triangulation without added points finds the triangles inside the holes,
     whose centres tell Triangle which regions to leave out of the refinement.
@@ -149,16 +149,19 @@ def _triangulate(xy, rings, spacing):
     if cKDTree(xy).query_pairs(_MERGED, output_type="ndarray").size:
         return None             # loops that touch: Triangle would merge (or crash on) them
     pslg = {"vertices": xy, "segments": seg}
-    if len(rings) > 1:
-        coarse = triangle.triangulate(pslg, "pQ")
-        cen = xy[coarse["triangles"]].mean(axis=1)
-        out = np.zeros(len(cen), bool)
-        for r in rings[1:]:
-            out |= Path(xy[r]).contains_points(cen)
-        if out.any():
-            pslg["holes"] = cen[out]
-    area = np.sqrt(3.0) / 4.0 * (spacing / scale) ** 2
-    got = triangle.triangulate(pslg, f"pqYYQa{area:.17f}")
+    area = max(np.sqrt(3.0) / 4.0 * (spacing / scale) ** 2, 1e-15)
+    try:
+        if len(rings) > 1:
+            coarse = triangle.triangulate(pslg, "pQ")
+            cen = coarse["vertices"][coarse["triangles"]].mean(axis=1)
+            out = np.zeros(len(cen), bool)
+            for r in rings[1:]:
+                out |= Path(xy[r]).contains_points(cen)
+            if out.any():
+                pslg["holes"] = cen[out]
+        got = triangle.triangulate(pslg, f"pqYYQa{area:.17f}")
+    except RuntimeError:        # "Triangulation failed": crossing segments it may not split
+        return None
     P, T = got["vertices"] * scale + lo, got["triangles"]
     m = len(P)
     edges = np.sort(np.concatenate([T[:, [0, 1]], T[:, [1, 2]], T[:, [2, 0]]]), axis=1)

@@ -117,3 +117,20 @@ def test_a_patch_whose_loops_touch_keeps_its_faces():
     assert flat.tolist() == [True] and meshed.tolist() == [False]
     np.testing.assert_array_equal(np.sort(V[F].reshape(-1, 3), axis=0),
                                   np.sort(res.vertices[res.faces].reshape(-1, 3), axis=0))
+
+
+def test_a_patch_whose_loops_cross_keeps_its_faces():
+    # a "hole" poking out through the outline: the loops cross, Triangle splits the
+    # segments there, and the patch keeps the faces it had
+    R, off = _frame(0.4)
+    curves, boundary, _, _ = _face(hole=False)
+    n = len(curves)
+    curves += _polygon_curves([(2.5, 0.5), (3.5, 0.3), (3.5, 0.7)], R, off)
+    boundary.append([(n + i, True) for i in range(3)])
+    res = surface_loops(curves, boundary[:1])
+    flat, normals, offsets = flat_planes(curves, [boundary])
+    fp = np.zeros(len(res.faces), np.int64)
+    V, F, FP, meshed = mesh_flat(res.vertices, res.faces, fp, res.curve_vertices, curves,
+                                 [boundary], flat, normals, offsets)
+    assert flat.tolist() == [True] and meshed.tolist() == [False]
+    assert len(F) == len(res.faces)
