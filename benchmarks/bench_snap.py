@@ -98,7 +98,8 @@ def patch_table(root, snap_tol=None):
     import warnings
 
     from curvenet.io import read_sketch
-    from curvenet.pipeline import _coverage, patches
+    from curvenet.pipeline import patches
+    from curvenet.route import coverage
 
     root = Path(root) / "sketches"
     files = (sorted((root / "vns").rglob("*.obj"))
@@ -110,7 +111,7 @@ def patch_table(root, snap_tol=None):
             warnings.simplefilter("ignore")
             sk = read_sketch(f)
             ps = patches(sk, snap_tol=snap_tol)
-        cov, _ = _coverage(ps)
+        cov, _ = coverage(ps)
         net = ps.network
         tot_p += len(ps.patches)
         tot_c += cov
