@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 from scipy.ndimage import maximum_filter1d
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from ._snap_auto import check_density
@@ -15,7 +17,7 @@ from .core.geometry import arc_length, cumulative_length, interpolate_polyline, 
 from .core.tolerances import DIVISION_GUARD
 from .network import CurveNetwork
 
-__all__ = ["UnionFind", "dedup", "snap_rough"]
+__all__ = ["components", "first_items", "dedup", "snap_rough"]
 
 #: Bound on the stroke samples of one snap: the sample spacing grows past tol / 4 to keep
 #: the total length / spacing under it.
@@ -23,32 +25,6 @@ _MAX_SAMPLES = 2_000_000
 
 
 # --------------------------------------------------------------------------- small tools
-class UnionFind:
-    """Array union-find over ``n`` items (path halving, smaller root wins)."""
-
-    def __init__(self, n):
-        self.parent = np.arange(n)
-
-    def find(self, i):
-        p = self.parent
-        while p[i] != i:
-            p[i] = p[p[i]]
-            i = p[i]
-        return i
-
-    def union(self, a, b):
-        ra, rb = self.find(a), self.find(b)
-        if ra != rb:
-            self.parent[max(ra, rb)] = min(ra, rb)
-
-    def union_pairs(self, pairs):
-        for a, b in pairs:
-            self.union(a, b)
-
-    def labels(self):
-        return np.array([self.find(i) for i in range(len(self.parent))], dtype=np.int64)
-
-
 def dedup(poly, eps):
     """Drop points within ``eps`` of their predecessor (the last point is kept)."""
     poly = np.asarray(poly, dtype=np.float64)
@@ -166,14 +142,50 @@ def _sample(st, h):
     return Q, sid, ss, tan, start, flat
 
 
-def _contacts(samples, tol, h, st, opts):
+def _contacts(samples, tol, h, st, opts, since=None):
     """Group close sample pairs of different strokes into contacts.
 
-    Returns a structured dict of arrays, one entry per contact: strokes ``a < b``,
-    extents on each, closest pair ``(i, j)`` (sample indices), ``overlap`` flag.
+    Parameters
+    ----------
+    since : (contacts, start, old) or None
+        The previous round's contacts and sample starts, and per stroke its index in
+        that round when it is unchanged since (its samples are then the same), else -1.
+        Only the sample pairs of changed strokes are searched; the contacts between
+        unchanged strokes are carried over, renumbered.
+
+    Returns
+    -------
+    dict of arrays, one entry per contact, ordered by strokes ``a < b`` and the start
+    on ``a``: extents on each stroke (``a0, a1, b0, b1``), closest pair ``(i, j)``
+    (sample indices) and its distance ``dist``, ``overlap`` flag.
     """
+    Q, sid, _, _, start = samples[:5]
+    if since is None:
+        return _group_pairs(cKDTree(Q).query_pairs(tol, output_type="ndarray"), samples, tol,
+                            h, st, opts)
+    con0, start0, old = since
+    fresh = old < 0
+    qc = np.flatnonzero(fresh[sid])  # samples of the changed strokes
+    near = cKDTree(Q[qc]).sparse_distance_matrix(cKDTree(Q), tol, output_type="ndarray")
+    i, j = qc[near["i"]], near["j"].astype(np.int64)
+    keep = (sid[i] != sid[j]) & (~fresh[sid[j]] | (i < j))  # each pair once
+    con = _group_pairs(np.stack([i[keep], j[keep]], axis=1), samples, tol, h, st, opts)
+    now = np.full(len(start0) - 1, -1)
+    now[old[~fresh]] = np.flatnonzero(~fresh)
+    a, b = now[con0["a"]], now[con0["b"]]
+    kept = np.flatnonzero((a >= 0) & (b >= 0))
+    carried = {k: v[kept] for k, v in con0.items()}
+    carried.update(a=a[kept], b=b[kept],
+                   i=con0["i"][kept] - start0[con0["a"][kept]] + start[a[kept]],
+                   j=con0["j"][kept] - start0[con0["b"][kept]] + start[b[kept]])
+    both = {k: np.concatenate([carried[k], con[k]]) for k in con}
+    order = np.lexsort((both["a0"], both["b"], both["a"]))
+    return {k: v[order] for k, v in both.items()}
+
+
+def _group_pairs(pairs, samples, tol, h, st, opts):
+    """Contacts (see :func:`_contacts`) from the close sample pairs ``(p, 2)``."""
     Q, sid, ss, tan = samples[:4]
-    pairs = cKDTree(Q).query_pairs(tol, output_type="ndarray")
     empty = {k: np.zeros(0, dtype=np.int64) for k in ("a", "b", "i", "j")}
     if len(pairs) == 0:
         return dict(empty, overlap=np.zeros(0, bool), a0=np.zeros(0), a1=np.zeros(0),
@@ -219,6 +231,15 @@ def _contacts(samples, tol, h, st, opts):
             "b0": b0, "b1": b1, "overlap": overlap, "dist": dist[bi]}
 
 
+def _unchanged(before, after):
+    """Per polyline of ``after``, its index in ``before`` if it is the same object, else -1.
+
+    Both lists must be alive (an object's id is unique only among live objects).
+    """
+    index = {id(p): k for k, p in enumerate(before)}
+    return np.array([index.get(id(p), -1) for p in after], dtype=np.int64)
+
+
 # --------------------------------------------------------------------------- junctions
 def _seg_seg(p0, p1, q0, q1):
     """Closest points of segment pairs, batched (Ericson, Real-Time Collision Detection 5.1.9).
@@ -248,7 +269,8 @@ def _seg_seg(p0, p1, q0, q1):
 
 
 def _candidates(st, samples, con, tol, h):
-    """Junction candidates: positions (m, 3) and members [(stroke, s), ...] per candidate.
+    """Junction candidates: positions ``(m, 3)``, the two member strokes ``(m, 2) int64``
+    and arc parameters on them ``(m, 2) float64`` of each, and the number of closed strokes.
 
     Each point contact's closest sample pair is refined to the closest points of
     the sample segments around it (four segment pairs, batched). The candidate
@@ -279,18 +301,15 @@ def _candidates(st, samples, con, tol, h):
     end_b = (sb <= 0.5 * h) | (sb >= flat.L[b] - 0.5 * h)
     pos = np.where((end_a & ~end_b)[:, None], pb,
                    np.where((end_b & ~end_a)[:, None], pa, 0.5 * (pa + pb)))
-    members = [[(int(x), float(y)), (int(z), float(w))]
-               for x, y, z, w in zip(a.tolist(), sa.tolist(), b.tolist(), sb.tolist())]
-    pos = list(pos)
-    closed = 0
-    for k in range(len(st)):  # closed strokes: the two ends meet
-        p = st.polys[k]
-        L = st.length(k)
-        if L > 4.0 * tol and np.linalg.norm(p[0] - p[-1]) <= tol:
-            pos.append(0.5 * (p[0] + p[-1]))
-            members.append([(k, 0.0), (k, float(L))])
-            closed += 1
-    return np.array(pos).reshape(-1, 3), members, closed
+    closed = [k for k in range(len(st))  # closed strokes: the two ends meet
+              if st.length(k) > 4.0 * tol and np.linalg.norm(st.polys[k][0] - st.polys[k][-1])
+              <= tol]
+    ends = np.array([[st.polys[k][0], st.polys[k][-1]] for k in closed]).reshape(-1, 2, 3)
+    pos = np.vstack([pos, 0.5 * (ends[:, 0] + ends[:, 1])])
+    mk = np.concatenate([np.stack([a, b], axis=1), np.repeat(closed, 2).reshape(-1, 2)])
+    ms = np.concatenate([np.stack([sa, sb], axis=1),
+                         np.array([[0.0, st.length(k)] for k in closed]).reshape(-1, 2)])
+    return pos, mk.astype(np.int64), ms.astype(np.float64), len(closed)
 
 
 def _closest_params(samples, k, lo, hi, target, h):
@@ -328,64 +347,73 @@ def _closest_params(samples, k, lo, hi, target, h):
     return fine[np.arange(len(k)), pick]
 
 
-def _cluster(samples, pos, members, tol, h, opts):
+def _cluster(samples, pos, mk, ms, tol, h):
     """Merge candidates into junctions; returns (positions, per-stroke member lists).
 
-    Per-stroke member list: sorted list of (s, junction id). Candidates within
-    ``tol`` merge; so do junctions that land within ``1.5 tol`` of each other
-    along one stroke (a corner whose pairwise contacts scattered).
+    ``mk``, ``ms`` (m, 2): the strokes each candidate lies on and its arc parameters
+    there. Per-stroke member list: sorted list of (s, junction id). Candidates within
+    ``tol`` merge; so do junctions that land within ``1.5 tol`` of each other along
+    one stroke (a corner whose pairwise contacts scattered), for up to four rounds.
+    Junctions are numbered by their first candidate.
     """
     m = len(pos)
-    uf = UnionFind(m)
-    if m > 1:
-        uf.union_pairs(cKDTree(pos).query_pairs(tol, output_type="ndarray").tolist())
+    if m == 0:
+        return np.zeros((0, 3)), {}
+    links = (cKDTree(pos).query_pairs(tol, output_type="ndarray") if m > 1
+             else np.zeros((0, 2), dtype=np.int64))  # candidates joined
+    mc = np.repeat(np.arange(m), 2)  # the candidate of each member
+    mk, ms = mk.ravel(), ms.ravel()
     for _ in range(4):
-        lab = uf.labels()
-        roots, cid = np.unique(lab, return_inverse=True)
-        J = np.zeros((len(roots), 3))
+        cid = components(m, links)
+        J = np.zeros((cid.max() + 1, 3))
         np.add.at(J, cid, pos)
-        J /= np.bincount(cid, minlength=len(roots))[:, None]
-        raw = {}
-        for c, mem in enumerate(members):
-            for k, s in mem:
-                raw.setdefault((int(cid[c]), k), []).append(s)
-        qk, qlo, qhi, qj = [], [], [], []
-        for (jn, k), svals in sorted(raw.items()):
-            svals = np.sort(np.asarray(svals))
-            runs = np.split(svals, np.flatnonzero(np.diff(svals) > 2.0 * tol) + 1)
-            for r in runs:
-                qk.append(k)
-                qlo.append(r[0] - tol)
-                qhi.append(r[-1] + tol)
-                qj.append(jn)
-        per_stroke = {}
-        if qk:
-            qs = _closest_params(samples, qk, np.array(qlo), np.array(qhi), J[qj], h)
-            for k, s, jn in zip(qk, qs.tolist(), qj):
-                per_stroke.setdefault(k, []).append((s, jn))
-        changed = False
-        first_member = {}  # junction -> a candidate index, to union by candidate
-        for c in range(m):
-            first_member.setdefault(int(cid[c]), c)
-        for lst in per_stroke.values():
-            lst.sort()
-            for (s1, j1), (s2, j2) in zip(lst[:-1], lst[1:]):
-                if j1 != j2 and s2 - s1 < 1.5 * tol:
-                    ra, rb = uf.find(first_member[j1]), uf.find(first_member[j2])
-                    if ra != rb:
-                        uf.union(ra, rb)
-                        changed = True
-        if not changed:
+        J /= np.bincount(cid, minlength=len(J))[:, None]
+        # each stroke's members of one junction, in runs no more than 2 tol apart: the
+        # point of the run's window on the stroke closest to the junction
+        jm = cid[mc]
+        order = np.lexsort((ms, mk, jm))
+        k_o, s_o, j_o = mk[order], ms[order], jm[order]
+        new = np.concatenate([[True], (k_o[1:] != k_o[:-1]) | (j_o[1:] != j_o[:-1])
+                              | (np.diff(s_o) > 2.0 * tol)])
+        first = np.flatnonzero(new)
+        last = np.append(first[1:], len(order)) - 1
+        qk, qj = k_o[first], j_o[first]
+        qs = (_closest_params(samples, qk, s_o[first] - tol, s_o[last] + tol, J[qj], h)
+              if len(qk) else np.zeros(0))
+        # per stroke by (s, junction): neighbours of different junctions closer than 1.5 tol
+        by = np.lexsort((qj, qs, qk))
+        qk, qs, qj = qk[by], qs[by], qj[by]
+        near = (qk[1:] == qk[:-1]) & (qj[1:] != qj[:-1]) & (np.diff(qs) < 1.5 * tol)
+        if not near.any():
             break
+        joined = np.stack([qj[:-1][near], qj[1:][near]], axis=1)  # junctions: by first member
+        links = np.concatenate([links, first_items(cid)[joined]])
     # one stroke, one junction, two equal parameters: keep one
-    for k, lst in per_stroke.items():
-        out = []
-        for s, jn in lst:
-            if out and out[-1][1] == jn and abs(out[-1][0] - s) < 0.5 * h:
-                continue
-            out.append((s, jn))
-        per_stroke[k] = out
+    per_stroke = {}
+    for k, s, jn in zip(qk.tolist(), qs.tolist(), qj.tolist()):
+        out = per_stroke.setdefault(k, [])
+        if out and out[-1][1] == jn and abs(out[-1][0] - s) < 0.5 * h:
+            continue
+        out.append((s, jn))
     return J, per_stroke
+
+
+def first_items(comp):
+    """Smallest item ``(c,) int64`` of each of the components ``comp (m,)`` numbers."""
+    first = np.full(comp.max() + 1, len(comp), dtype=np.int64)
+    np.minimum.at(first, comp, np.arange(len(comp)))
+    return first
+
+
+def components(m, links):
+    """Connected components of ``m`` items joined by the pairs ``links (p, 2)``, numbered
+    in the order of their smallest item (as union-find with the smaller root winning)."""
+    graph = coo_matrix((np.ones(len(links)), (links[:, 0], links[:, 1])), shape=(m, m))
+    _, comp = connected_components(graph, directed=False)
+    _, first = np.unique(comp, return_index=True)
+    rank = np.empty(len(first), dtype=np.int64)
+    rank[np.argsort(first)] = np.arange(len(first))
+    return rank[comp]
 
 
 def _corners(samples, tol, h, opts):
@@ -562,22 +590,25 @@ def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
     total = sum(st.length(k) for k in range(len(st)))
     h = max(0.25 * tol, total / _MAX_SAMPLES)
     # overdraw first: it changes the strokes the junctions are found on
+    since = None
     for _round in range(12):
         samples = _sample(st, h)
         if _round == 0:
             check_density(samples, tol, opts.snap_tol)
-        con = _contacts(samples, tol, h, st, opts)
+        con = _contacts(samples, tol, h, st, opts, since)
         if not con["overlap"].any():
             break
+        polys = list(st.polys)  # consolidate edits st: keep the polylines before it
         st = consolidate(st, samples, con, tol, h, opts, report)
+        since = (con, samples[4], _unchanged(polys, st.polys))
     else:
         samples = _sample(st, h)
-        con = _contacts(samples, tol, h, st, opts)
+        con = _contacts(samples, tol, h, st, opts, since)
         if con["overlap"].any():
             report["warnings"].append("overdraw left after 12 rounds; treated as crossings")
             con["overlap"][:] = False
-    pos, members, report["closed_strokes"] = _candidates(st, samples, con, tol, h)
-    J, per_stroke = _cluster(samples, pos, members, tol, h, opts)
+    pos, mk, ms, report["closed_strokes"] = _candidates(st, samples, con, tol, h)
+    J, per_stroke = _cluster(samples, pos, mk, ms, tol, h)
     nj = len(J)
     verts = [p for p in J]
     corner_ids = set()

@@ -65,7 +65,7 @@ from scipy.spatial import cKDTree
 
 from .core.tolerances import COINCIDENT_REL, DUPLICATE_POINT_REL, check_snap_tol
 from .errors import InvalidParameterError
-from ._snap_rough import UnionFind, dedup
+from ._snap_rough import components, dedup, first_items
 from .network import CurveNetwork, indexed_network
 from .sketch import Sketch
 
@@ -198,12 +198,8 @@ def _snap_exact(strokes, src, labels, diag):
     """Graph of exactly coincident points (no tolerance); see module docstring."""
     pts = np.concatenate(strokes)
     eps = COINCIDENT_REL * diag
-    pairs = cKDTree(pts).query_pairs(eps, output_type="ndarray")
-    uf = UnionFind(len(pts))
-    uf.union_pairs(pairs.tolist())
-    group = uf.labels()
-    uniq, ids = np.unique(group, return_inverse=True)
-    verts = pts[uniq]
+    ids = components(len(pts), cKDTree(pts).query_pairs(eps, output_type="ndarray"))
+    verts = pts[first_items(ids)]  # each group at its first point
     offs = np.cumsum([0] + [len(s) for s in strokes])
     polys = [ids[offs[k]:offs[k + 1]] for k in range(len(strokes))]
     net = indexed_network(verts, polys, labels, src)
