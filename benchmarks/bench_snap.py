@@ -146,12 +146,12 @@ def big_inputs(folder):
 
 
 _CHILD = """
-import resource, sys, time
+import os, resource, sys, time
 resource.setrlimit(resource.RLIMIT_AS, (int(sys.argv[2]) << 30, int(sys.argv[2]) << 30))
 from curvenet.errors import CurvenetError
 from curvenet.io import read_sketch
 from curvenet.snap import snap
-t = time.perf_counter()
+t, c = time.perf_counter(), time.process_time()
 try:
     net = snap(read_sketch(sys.argv[1]))
     out = f"ok: {net.number_of_vertices} vertices, {net.number_of_edges} curves; " \
@@ -161,27 +161,31 @@ except CurvenetError as err:
 except MemoryError:
     out = "MemoryError"
 peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 2**20
-print(f"{time.perf_counter() - t:.1f}|{peak:.2f}|{out}")
+print(f"{time.perf_counter() - t:.1f}|{time.process_time() - c:.1f}|{os.getloadavg()[0]:.1f}|"
+      f"{peak:.2f}|{out}")
 """
 
 
 def big_table(folder, cap_gb=5):
     """Read and snap each big input in a child process; its peak memory (RSS) and seconds.
 
-    The child's address space is capped at ``cap_gb`` GiB (``RLIMIT_AS``) so a run that
-    would need more ends with MemoryError instead of swapping a shared machine.
+    Seconds: wall and CPU (the child's process time; on a shared machine the better
+    estimate of an idle run), and the 1-minute load average at the end. The child's
+    address space is capped at ``cap_gb`` GiB (``RLIMIT_AS``) so a run that would need
+    more ends with MemoryError instead of swapping a shared machine.
     """
     import subprocess
     import sys
 
-    print(f"{'input':16s} {'MB':>6s} {'peak GB':>8s} {'sec':>7s}  result")
+    print(f"{'input':16s} {'MB':>6s} {'peak GB':>8s} {'wall s':>7s} {'cpu s':>7s} {'load':>5s}  "
+          "result")
     for f in big_inputs(folder):
         r = subprocess.run([sys.executable, "-c", _CHILD, str(f), str(cap_gb)],
                            capture_output=True, text=True)
-        last = (r.stdout.strip().splitlines() or ["-|-|" + r.stderr.strip()[-120:]])[-1]
-        sec, peak, out = last.split("|", 2)
-        print(f"{f.name:16s} {f.stat().st_size / 1e6:6.0f} {peak:>8s} {sec:>7s}  {out}",
-              flush=True)
+        last = (r.stdout.strip().splitlines() or ["-|-|-|-|" + r.stderr.strip()[-120:]])[-1]
+        sec, cpu, load, peak, out = last.split("|", 4)
+        print(f"{f.name:16s} {f.stat().st_size / 1e6:6.0f} {peak:>8s} {sec:>7s} {cpu:>7s} "
+              f"{load:>5s}  {out}", flush=True)
 
 
 def main(argv=None):

@@ -543,7 +543,9 @@ def _merge_slivers(edges, tol):
     """Average parallel edges (same end vertices) whose curves stay within ``2 tol``.
 
     The curves are compared at 64 points equally spaced in arc length; a vectorised
-    estimate (:func:`_resampled_far`) skips the pairs that are clearly farther apart.
+    estimate (:func:`_resampled_far`) skips the edge pairs that are alone between their
+    vertices and clearly farther apart. (Larger groups are compared pair by pair: their
+    merges remove edges from the later pairs.)
     """
     count = 0
     groups = {}
@@ -552,7 +554,10 @@ def _merge_slivers(edges, tol):
             groups.setdefault((min(e[0], e[1]), max(e[0], e[1])), []).append(e_id)
     pairs = [(u, ids[x], ids[y]) for (u, _v), ids in sorted(groups.items())
              for x in range(len(ids)) for y in range(x + 1, len(ids))]
-    far = _resampled_far(edges, pairs, 2.0 * tol)
+    two = np.flatnonzero([len(groups[min(e[0], e[1]), max(e[0], e[1])]) == 2
+                          for e in (edges[ex] for _, ex, _ in pairs)])
+    far = np.zeros(len(pairs), dtype=bool)
+    far[two] = _resampled_far(edges, [pairs[k] for k in two], 2.0 * tol)
     dead, moved = set(), set()
     for (u, ex, ey), skip in zip(pairs, far):
         if ex in dead or ey in dead or (skip and ex not in moved):
