@@ -13,8 +13,8 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from ._snap_auto import check_density
-from .core.geometry import arc_length, cumulative_length, interpolate_polyline, resample_polyline
-from .core.tolerances import DIVISION_GUARD, ZERO_LENGTH
+from .core.geometry import arc_length, cumulative_length, interpolate_polyline
+from .core.tolerances import DIVISION_GUARD
 from .network import CurveNetwork
 
 __all__ = ["components", "first_items", "dedup", "snap_rough"]
@@ -229,6 +229,31 @@ def _group_pairs(pairs, samples, tol, h, st, opts):
         mean_cos >= np.cos(np.radians(opts.overdraw_angle)))
     return {"a": sa, "b": sb, "i": i[bi], "j": j[bi], "a0": a0, "a1": a1,
             "b0": b0, "b1": b1, "overlap": overlap, "dist": dist[bi]}
+
+
+def _overdraw_rounds(st, tol, h, opts, report):
+    """Consolidate overdraw (up to 12 rounds) before junctions are sought.
+
+    Returns the strokes, their samples and their contacts (none an overlap).
+    """
+    from ._snap_overdraw import consolidate  # it imports this module's helpers
+    since = None
+    for _round in range(12):
+        samples = _sample(st, h)
+        if _round == 0:
+            check_density(samples, tol, opts.snap_tol)
+        con = _contacts(samples, tol, h, st, opts, since)
+        if not con["overlap"].any():
+            return st, samples, con
+        polys = list(st.polys)  # consolidate edits st: keep the polylines before it
+        st = consolidate(st, samples, con, tol, h, opts, report)
+        since = (con, samples[4], _unchanged(polys, st.polys))
+    samples = _sample(st, h)
+    con = _contacts(samples, tol, h, st, opts, since)
+    if con["overlap"].any():
+        report["warnings"].append("overdraw left after 12 rounds; treated as crossings")
+        con["overlap"][:] = False
+    return st, samples, con
 
 
 def _unchanged(before, after):
@@ -539,79 +564,9 @@ def _dissolve(edges, corner_ids, tol, opts, nverts):
     return [e for e in edges if e is not None], count
 
 
-def _merge_slivers(edges, tol):
-    """Average parallel edges (same end vertices) whose curves stay within ``2 tol``.
-
-    The curves are compared at 64 points equally spaced in arc length; a vectorised
-    estimate (:func:`_resampled_far`) skips the edge pairs that are alone between their
-    vertices and clearly farther apart. (Larger groups are compared pair by pair: their
-    merges remove edges from the later pairs.)
-    """
-    count = 0
-    groups = {}
-    for e_id, e in enumerate(edges):
-        if e[0] != e[1]:
-            groups.setdefault((min(e[0], e[1]), max(e[0], e[1])), []).append(e_id)
-    pairs = [(u, ids[x], ids[y]) for (u, _v), ids in sorted(groups.items())
-             for x in range(len(ids)) for y in range(x + 1, len(ids))]
-    two = np.flatnonzero([len(groups[min(e[0], e[1]), max(e[0], e[1])]) == 2
-                          for e in (edges[ex] for _, ex, _ in pairs)])
-    far = np.zeros(len(pairs), dtype=bool)
-    far[two] = _resampled_far(edges, [pairs[k] for k in two], 2.0 * tol)
-    dead, moved = set(), set()
-    for (u, ex, ey), skip in zip(pairs, far):
-        if ex in dead or ey in dead or (skip and ex not in moved):
-            continue
-        cx, cy = (resample_polyline(edges[k][2] if edges[k][0] == u else edges[k][2][::-1], 63)
-                  for k in (ex, ey))
-        if np.linalg.norm(cx - cy, axis=1).max() <= 2.0 * tol:
-            avg = 0.5 * (cx + cy)
-            e = edges[ex]
-            label = "crease" if "crease" in (e[4], edges[ey][4]) else "boundary"
-            if e[0] != u:
-                avg = avg[::-1]
-            edges[ex] = (e[0], e[1], avg, tuple(sorted(set(e[3]) | set(edges[ey][3]))), label)
-            dead.add(ey)
-            moved.add(ex)
-            count += 1
-    return [e for i, e in enumerate(edges) if i not in dead], count
-
-
-def _resampled_far(edges, pairs, dist, batch=4096):
-    """Per pair ``(u, ex, ey)``: whether the two curves, both from ``u`` and resampled at 64
-    points equally spaced in arc length, certainly have a point pair farther than ``dist``.
-
-    Vectorised over the pairs (a stroke-wide cumulative sum, so not bit-exact): pairs
-    within ``1e-6 dist`` of the limit and curves shorter than ``ZERO_LENGTH`` count as
-    not far, and are compared exactly by the caller.
-    """
-    far = np.zeros(len(pairs), dtype=bool)
-    t = np.linspace(0.0, 1.0, 64)
-    for b0 in range(0, len(pairs), batch):
-        chunk = pairs[b0:b0 + batch]
-        curves = [edges[k][2] if edges[k][0] == u else edges[k][2][::-1]
-                  for u, ex, ey in chunk for k in (ex, ey)]
-        cnt = np.array([len(c) for c in curves])
-        off = np.concatenate([[0], np.cumsum(cnt)])
-        P = np.concatenate(curves)
-        seg = np.linalg.norm(np.diff(P, axis=0), axis=1)
-        seg[off[1:-1] - 1] = 0.0  # no length between consecutive curves
-        cum = np.concatenate([[0.0], np.cumsum(seg)])
-        base, total = cum[off[:-1]], cum[off[1:] - 1] - cum[off[:-1]]
-        g = base[:, None] + t[None, :] * total[:, None]  # (2 b, 64) global parameters
-        j = np.clip(np.searchsorted(cum, g, side="right") - 1, off[:-1, None], off[1:, None] - 2)
-        step = cum[j + 1] - cum[j]
-        w = np.where(step > 0, (g - cum[j]) / np.where(step > 0, step, 1.0), 0.0)
-        pts = (P[j] + w[..., None] * (P[j + 1] - P[j])).reshape(-1, 2, 64, 3)
-        d = np.linalg.norm(pts[:, 0] - pts[:, 1], axis=2).max(axis=1)
-        tiny = (total <= ZERO_LENGTH).reshape(-1, 2).any(axis=1)
-        far[b0:b0 + batch] = (d > dist * (1.0 + 1e-6)) & ~tiny
-    return far
-
-
 def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
     """Tolerance-based snapping; see :mod:`curvenet.snap` for the steps."""
-    from ._snap_overdraw import consolidate  # it imports this module's helpers
+    from ._snap_overdraw import merge_slivers  # it imports this module's helpers
     tol = opts.snap_tol * diag
     report = {"mode": "rough", "crossings": 0, "t_junctions": 0, "gap_merges": 0,
               "closed_strokes": 0, "trimmed_overshoots": 0, "overdraw_consolidations": 0,
@@ -630,24 +585,7 @@ def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
         return net
     total = sum(st.length(k) for k in range(len(st)))
     h = max(0.25 * tol, total / _MAX_SAMPLES)
-    # overdraw first: it changes the strokes the junctions are found on
-    since = None
-    for _round in range(12):
-        samples = _sample(st, h)
-        if _round == 0:
-            check_density(samples, tol, opts.snap_tol)
-        con = _contacts(samples, tol, h, st, opts, since)
-        if not con["overlap"].any():
-            break
-        polys = list(st.polys)  # consolidate edits st: keep the polylines before it
-        st = consolidate(st, samples, con, tol, h, opts, report)
-        since = (con, samples[4], _unchanged(polys, st.polys))
-    else:
-        samples = _sample(st, h)
-        con = _contacts(samples, tol, h, st, opts, since)
-        if con["overlap"].any():
-            report["warnings"].append("overdraw left after 12 rounds; treated as crossings")
-            con["overlap"][:] = False
+    st, samples, con = _overdraw_rounds(st, tol, h, opts, report)
     pos, mk, ms, report["closed_strokes"] = _candidates(st, samples, con, tol, h)
     J, per_stroke = _cluster(samples, pos, mk, ms, tol, h)
     nj = len(J)
@@ -724,7 +662,7 @@ def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
         elif through[j] == 0 and ends_at[j] >= 2:
             report["gap_merges"] += 1
     edges, report["dissolved_joins"] = _dissolve(edges, corner_ids, tol, opts, len(verts))
-    edges, report["slivers_merged"] = _merge_slivers(edges, tol)
+    edges, report["slivers_merged"] = merge_slivers(edges, tol)
     used = sorted({e[0] for e in edges} | {e[1] for e in edges})
     new_id = {v: i for i, v in enumerate(used)}
     net = CurveNetwork(np.array([verts[v] for v in used]).reshape(-1, 3))
