@@ -134,6 +134,35 @@ def test_closed_stroke_becomes_loop_edge():
     assert net.report["junctions"] == 2
 
 
+@pytest.mark.parametrize("name", ["latlong_sphere", "torus", "grid_box"])
+def test_overdraw_rounds_search_only_changed_strokes_with_the_same_result(name, monkeypatch):
+    """Oracle: carrying the contacts of unchanged strokes from round to round gives the
+    network of a full pair search in every round."""
+    from curvenet import _snap_rough
+
+    sketch = rough_sketch(getattr(shapes, name)().network, seed=1, overdraw=1.0)
+    real = _snap_rough._contacts
+    carried = []
+
+    def spy(samples, tol, h, st, opts, since=None):
+        carried.append(since is not None)
+        return real(samples, tol, h, st, opts, since)
+
+    monkeypatch.setattr(_snap_rough, "_contacts", spy)
+    fast = snap(sketch)
+    monkeypatch.setattr(_snap_rough, "_contacts",
+                        lambda samples, tol, h, st, opts, since=None: real(samples, tol, h, st,
+                                                                           opts))
+    full = snap(sketch)
+    assert sum(carried) >= 2 and fast.report["overdraw_consolidations"] >= 8
+    assert fast.report == full.report
+    np.testing.assert_array_equal(fast.positions, full.positions)
+    assert [(e.u, e.v, e.strokes, e.label) for e in fast.edges] == \
+        [(e.u, e.v, e.strokes, e.label) for e in full.edges]
+    for a, b in zip(fast.edges, full.edges):
+        np.testing.assert_array_equal(a.curve, b.curve)
+
+
 def test_overdraw_is_averaged_not_a_sliver():
     rng = np.random.default_rng(0)
     a = line([-0.8, 0, 0], [0.8, 0, 0], 81)
