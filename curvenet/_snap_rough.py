@@ -22,6 +22,8 @@ __all__ = ["components", "first_items", "dedup", "snap_rough"]
 #: Bound on the stroke samples of one snap: the sample spacing grows past tol / 4 to keep
 #: the total length / spacing under it.
 _MAX_SAMPLES = 2_000_000
+#: Samples of changed strokes whose neighbours are sought at once (bounds the pairs held).
+_PAIR_BLOCK = 100_000
 
 
 # --------------------------------------------------------------------------- small tools
@@ -150,8 +152,8 @@ def _contacts(samples, tol, h, st, opts, since=None):
     since : (contacts, start, old) or None
         The previous round's contacts and sample starts, and per stroke its index in
         that round when it is unchanged since (its samples are then the same), else -1.
-        Only the sample pairs of changed strokes are searched; the contacts between
-        unchanged strokes are carried over, renumbered.
+        Only the sample pairs of changed strokes are searched (all pairs when they hold
+        most samples); the contacts between unchanged strokes are carried over, renumbered.
 
     Returns
     -------
@@ -160,16 +162,20 @@ def _contacts(samples, tol, h, st, opts, since=None):
     (sample indices) and its distance ``dist``, ``overlap`` flag.
     """
     Q, sid, _, _, start = samples[:5]
-    if since is None:
+    fresh = None if since is None else since[2] < 0
+    if fresh is None or 2 * np.count_nonzero(fresh[sid]) > len(Q):  # most strokes changed
         return _group_pairs(cKDTree(Q).query_pairs(tol, output_type="ndarray"), samples, tol,
                             h, st, opts)
     con0, start0, old = since
-    fresh = old < 0
     qc = np.flatnonzero(fresh[sid])  # samples of the changed strokes
-    near = cKDTree(Q[qc]).sparse_distance_matrix(cKDTree(Q), tol, output_type="ndarray")
-    i, j = qc[near["i"]], near["j"].astype(np.int64)
-    keep = (sid[i] != sid[j]) & (~fresh[sid[j]] | (i < j))  # each pair once
-    con = _group_pairs(np.stack([i[keep], j[keep]], axis=1), samples, tol, h, st, opts)
+    tree, parts = cKDTree(Q), []
+    for lo in range(0, len(qc), _PAIR_BLOCK):  # in blocks: most pairs found are discarded
+        qb = qc[lo:lo + _PAIR_BLOCK]
+        near = cKDTree(Q[qb]).sparse_distance_matrix(tree, tol, output_type="ndarray")
+        i, j = qb[near["i"]], near["j"].astype(np.int64)
+        keep = (sid[i] != sid[j]) & (~fresh[sid[j]] | (i < j))  # each pair once
+        parts.append(np.stack([i[keep], j[keep]], axis=1))
+    con = _group_pairs(np.concatenate(parts), samples, tol, h, st, opts)
     now = np.full(len(start0) - 1, -1)
     now[old[~fresh]] = np.flatnonzero(~fresh)
     a, b = now[con0["a"]], now[con0["b"]]

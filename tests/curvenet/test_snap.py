@@ -134,7 +134,7 @@ def test_closed_stroke_becomes_loop_edge():
     assert net.report["junctions"] == 2
 
 
-@pytest.mark.parametrize("name", ["latlong_sphere", "torus", "grid_box"])
+@pytest.mark.parametrize("name", ["latlong_sphere", "torus", "saddle_grid"])
 def test_overdraw_rounds_search_only_changed_strokes_with_the_same_result(name, monkeypatch):
     """Oracle: carrying the contacts of unchanged strokes from round to round gives the
     network of a full pair search in every round."""
@@ -144,8 +144,9 @@ def test_overdraw_rounds_search_only_changed_strokes_with_the_same_result(name, 
     real = _snap_rough._contacts
     carried = []
 
-    def spy(samples, tol, h, st, opts, since=None):
-        carried.append(since is not None)
+    def spy(samples, tol, h, st, opts, since=None):  # rounds where few strokes changed
+        carried.append(since is not None and
+                       2 * np.count_nonzero(since[2][samples[1]] < 0) <= len(samples[0]))
         return real(samples, tol, h, st, opts, since)
 
     monkeypatch.setattr(_snap_rough, "_contacts", spy)
