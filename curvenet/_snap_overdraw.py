@@ -13,7 +13,7 @@ from scipy.spatial import cKDTree
 
 from ._snap_rough import _clean, _smoothstep, _Strokes
 from .core.geometry import interpolate_polyline, resample_polyline
-from .core.tolerances import DIVISION_GUARD, ZERO_LENGTH
+from .core.tolerances import DIVISION_GUARD
 
 __all__ = ["consolidate", "merge_slivers"]
 
@@ -126,70 +126,29 @@ def _cut(poly, cum, a, b):
 
 
 def merge_slivers(edges, tol):
-    """Average parallel edges (same end vertices) whose curves stay within ``2 tol``.
-
-    The curves are compared at 64 points equally spaced in arc length; a vectorised
-    estimate (:func:`_resampled_far`) skips the edge pairs that are alone between their
-    vertices and clearly farther apart. (Larger groups are compared pair by pair: their
-    merges remove edges from the later pairs.)
-    """
+    """Average parallel edges (same end vertices) whose curves stay within ``2 tol``."""
     count = 0
     groups = {}
     for e_id, e in enumerate(edges):
         if e[0] != e[1]:
             groups.setdefault((min(e[0], e[1]), max(e[0], e[1])), []).append(e_id)
-    pairs = [(u, ids[x], ids[y]) for (u, _v), ids in sorted(groups.items())
-             for x in range(len(ids)) for y in range(x + 1, len(ids))]
-    two = np.flatnonzero([len(groups[min(e[0], e[1]), max(e[0], e[1])]) == 2
-                          for e in (edges[ex] for _, ex, _ in pairs)])
-    far = np.zeros(len(pairs), dtype=bool)
-    far[two] = _resampled_far(edges, [pairs[k] for k in two], 2.0 * tol)
-    dead, moved = set(), set()
-    for (u, ex, ey), skip in zip(pairs, far):
-        if ex in dead or ey in dead or (skip and ex not in moved):
-            continue
-        cx, cy = (resample_polyline(edges[k][2] if edges[k][0] == u else edges[k][2][::-1], 63)
-                  for k in (ex, ey))
-        if np.linalg.norm(cx - cy, axis=1).max() <= 2.0 * tol:
-            avg = 0.5 * (cx + cy)
-            e = edges[ex]
-            label = "crease" if "crease" in (e[4], edges[ey][4]) else "boundary"
-            if e[0] != u:
-                avg = avg[::-1]
-            edges[ex] = (e[0], e[1], avg, tuple(sorted(set(e[3]) | set(edges[ey][3]))), label)
-            dead.add(ey)
-            moved.add(ex)
-            count += 1
+    dead = set()
+    for (u, _v), ids in sorted(groups.items()):
+        for x in range(len(ids)):
+            for y in range(x + 1, len(ids)):
+                ex, ey = ids[x], ids[y]
+                if ex in dead or ey in dead:
+                    continue
+                cx, cy = (resample_polyline(edges[k][2] if edges[k][0] == u else edges[k][2][::-1],
+                                            63) for k in (ex, ey))
+                if np.linalg.norm(cx - cy, axis=1).max() <= 2.0 * tol:
+                    avg = 0.5 * (cx + cy)
+                    e = edges[ex]
+                    label = "crease" if "crease" in (e[4], edges[ey][4]) else "boundary"
+                    if e[0] != u:
+                        avg = avg[::-1]
+                    edges[ex] = (e[0], e[1], avg, tuple(sorted(set(e[3]) | set(edges[ey][3]))),
+                                 label)
+                    dead.add(ey)
+                    count += 1
     return [e for i, e in enumerate(edges) if i not in dead], count
-
-
-def _resampled_far(edges, pairs, dist, batch=4096):
-    """Per pair ``(u, ex, ey)``: whether the two curves, both from ``u`` and resampled at 64
-    points equally spaced in arc length, certainly have a point pair farther than ``dist``.
-
-    Vectorised over the pairs (a stroke-wide cumulative sum, so not bit-exact): pairs
-    within ``1e-6 dist`` of the limit and curves shorter than ``ZERO_LENGTH`` count as
-    not far, and are compared exactly by the caller.
-    """
-    far = np.zeros(len(pairs), dtype=bool)
-    t = np.linspace(0.0, 1.0, 64)
-    for b0 in range(0, len(pairs), batch):
-        chunk = pairs[b0:b0 + batch]
-        curves = [edges[k][2] if edges[k][0] == u else edges[k][2][::-1]
-                  for u, ex, ey in chunk for k in (ex, ey)]
-        cnt = np.array([len(c) for c in curves])
-        off = np.concatenate([[0], np.cumsum(cnt)])
-        P = np.concatenate(curves)
-        seg = np.linalg.norm(np.diff(P, axis=0), axis=1)
-        seg[off[1:-1] - 1] = 0.0  # no length between consecutive curves
-        cum = np.concatenate([[0.0], np.cumsum(seg)])
-        base, total = cum[off[:-1]], cum[off[1:] - 1] - cum[off[:-1]]
-        g = base[:, None] + t[None, :] * total[:, None]  # (2 b, 64) global parameters
-        j = np.clip(np.searchsorted(cum, g, side="right") - 1, off[:-1, None], off[1:, None] - 2)
-        step = cum[j + 1] - cum[j]
-        w = np.where(step > 0, (g - cum[j]) / np.where(step > 0, step, 1.0), 0.0)
-        pts = (P[j] + w[..., None] * (P[j + 1] - P[j])).reshape(-1, 2, 64, 3)
-        d = np.linalg.norm(pts[:, 0] - pts[:, 1], axis=2).max(axis=1)
-        tiny = (total <= ZERO_LENGTH).reshape(-1, 2).any(axis=1)
-        far[b0:b0 + batch] = (d > dist * (1.0 + 1e-6)) & ~tiny
-    return far
