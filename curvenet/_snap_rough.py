@@ -175,7 +175,8 @@ def _contacts(samples, tol, h, st, opts, since=None):
         i, j = qb[near["i"]], near["j"].astype(np.int64)
         keep = (sid[i] != sid[j]) & (~fresh[sid[j]] | (i < j))  # each pair once
         parts.append(np.stack([i[keep], j[keep]], axis=1))
-    con = _group_pairs(np.concatenate(parts), samples, tol, h, st, opts)
+    pairs = np.concatenate(parts) if parts else np.zeros((0, 2), dtype=np.int64)
+    con = _group_pairs(pairs, samples, tol, h, st, opts)
     now = np.full(len(start0) - 1, -1)
     now[old[~fresh]] = np.flatnonzero(~fresh)
     a, b = now[con0["a"]], now[con0["b"]]
