@@ -26,18 +26,21 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
-import scipy.sparse as sp
 from scipy.interpolate import BSpline
 
-from .catmull_clark import edge_index, edge_topology, sharp_mask, subdivision_step
+from .catmull_clark import (CORNER, CREASE, SMOOTH, edge_index, edge_topology, sharp_mask,
+                            subdivision_step, vertex_classes)
+from .graded import DEFAULT_GRADE, MAX_GRADE, corner_chains, fit_graded, span_points, submesh
 from .limit import limit_matrix
 
 __all__ = ["ControlNet", "BSplinePiece", "BSplineSet", "piece_grids", "refine_grid",
            "extract_bsplines", "uniform_knots", "clamp_uniform", "evaluate", "project",
-           "DEFAULT_LEVEL", "EXACT_TOL"]
+           "DEFAULT_LEVEL", "DEFAULT_TOLERANCE", "EXACT_TOL"]
 
 #: Subdivision steps before the pieces are read off as B-splines.
 DEFAULT_LEVEL = 3
+#: Target deviation of the fitted pieces, fraction of the diagonal.
+DEFAULT_TOLERANCE = 2e-5
 #: Spans whose limit samples deviate more than this fraction of the diagonal from the
 #: uniform B-spline are irregular (exact spans agree to rounding, about 1e-15).
 EXACT_TOL = 1e-10
@@ -173,8 +176,9 @@ def _grid_quads(G):
 
 def _diag_lookup(quads: np.ndarray, n: int):
     """Face of a quad given a diagonal ``(a, c)`` and, where two quads share that
-    diagonal (two patches on the same loop), a third vertex ``b``:
-    ``find(a, c, b=None) -> face or -1``."""
+    diagonal (two patches on the same loop, or folded onto each other at a
+    valence-two vertex), its other vertices ``b`` and ``d`` where known:
+    ``find(a, c, b=None, d=None) -> face or -1``."""
     k02 = np.minimum(quads[:, 0], quads[:, 2]) * n + np.maximum(quads[:, 0], quads[:, 2])
     k13 = np.minimum(quads[:, 1], quads[:, 3]) * n + np.maximum(quads[:, 1], quads[:, 3])
     keys = np.concatenate([k02, k13])
@@ -183,14 +187,16 @@ def _diag_lookup(quads: np.ndarray, n: int):
     keys, face = keys[order], face[order]
     last = len(keys) - 1
 
-    def find(a, c, b=None):
+    def find(a, c, b=None, d=None):
         k = np.minimum(a, c) * n + np.maximum(a, c)
         pos = np.clip(np.searchsorted(keys, k), 0, last)
         f = np.where(keys[pos] == k, face[pos], -1)
         if b is not None:
+            has = (quads[f] == np.asarray(b)[..., None]).any(-1)
+            if d is not None:
+                has &= (quads[f] == np.asarray(d)[..., None]).any(-1)
             nxt = np.minimum(pos + 1, last)
-            alt = (keys[nxt] == k) & (nxt != pos) & ~(quads[f] == np.asarray(b)[..., None]).any(-1)
-            f = np.where(alt, face[nxt], f)
+            f = np.where((keys[nxt] == k) & (nxt != pos) & ~has, face[nxt], f)
         return f
     return find
 
@@ -219,8 +225,8 @@ def refine_grid(G: np.ndarray, quads: np.ndarray, topo, find=None) -> np.ndarray
     H[0::2, 0::2] = G
     H[1::2, 0::2] = n + edge_index(topo, G[:-1].ravel(), G[1:].ravel()).reshape(p, q + 1)
     H[0::2, 1::2] = n + edge_index(topo, G[:, :-1].ravel(), G[:, 1:].ravel()).reshape(p + 1, q)
-    H[1::2, 1::2] = n + ne + find(G[:-1, :-1].ravel(), G[1:, 1:].ravel(),
-                                  G[1:, :-1].ravel()).reshape(p, q)
+    H[1::2, 1::2] = n + ne + find(G[:-1, :-1].ravel(), G[1:, 1:].ravel(), G[1:, :-1].ravel(),
+                                  G[:-1, 1:].ravel()).reshape(p, q)
     return H
 
 
@@ -239,21 +245,31 @@ def _design(x, m: int) -> np.ndarray:
     return BSpline.design_matrix(np.asarray(x, np.float64), uniform_knots(m), 3).toarray()
 
 
-def clamp_uniform(poles: np.ndarray, m: int, axis: int) -> tuple:
+def clamp_uniform(poles: np.ndarray, m: int, axis: int, breaks=None) -> tuple:
     """Re-express uniform unclamped cubic poles along ``axis`` with clamped knots.
 
-    Same spline on ``[0, m]``, same number of poles; the clamped end poles are the
-    end points of the surface, so pieces sharing a boundary curve share its poles.
+    Same spline on ``[0, m]``; the clamped end poles are the end points of the
+    surface, so pieces sharing a boundary curve share its poles.
+
+    Parameters
+    ----------
+    poles : (..., m + 3, ...) float64
+    m : int
+    axis : int
+    breaks : (b,) float64, optional
+        Breakpoints from 0 to m that include ``0, 1, ..., m`` (default exactly
+        those); extra ones refine the knot vector (knot insertion: the same spline).
 
     Returns
     -------
-    poles : same shape
-    knots : (m + 7,) float64 -- ``0, 0, 0, 0, 1, ..., m - 1, m, m, m, m``
+    poles : ``len(breaks) + 2`` along ``axis``
+    knots : (len(breaks) + 6,) float64 -- ``0, 0, 0, breaks, m, m, m``
     """
-    t = np.r_[[0.0] * 3, np.arange(m + 1, dtype=np.float64), [float(m)] * 3]
+    b = np.arange(m + 1, dtype=np.float64) if breaks is None else np.asarray(breaks, np.float64)
+    t = np.r_[[0.0] * 3, b, [float(m)] * 3]
     g = (t[1:-3] + t[2:-2] + t[3:-1]) / 3.0                  # Greville abscissae
     A_new = BSpline.design_matrix(g, t, 3).toarray()
-    R = np.linalg.solve(A_new, _design(g, m))                 # (m + 3, m + 3)
+    R = np.linalg.solve(A_new, _design(g, m))                 # (len(b) + 2, m + 3)
     return np.moveaxis(np.tensordot(R, np.moveaxis(poles, axis, 0), axes=1), 0, axis), t
 
 
@@ -265,30 +281,51 @@ def evaluate(piece: BSplinePiece, u, v, derivatives: bool = False):
     (k, 3) float64, or a tuple of three when ``derivatives``.
     """
     u, v = np.asarray(u, np.float64), np.asarray(v, np.float64)
-    nu, nv = len(piece.knots_u) - 4, len(piece.knots_v) - 4
-    flat = piece.poles.reshape(nu, -1)
+    if not len(u):
+        z = np.zeros((0, 3))
+        return (z, z, z) if derivatives else z
+    iu, bu = _basis(u, piece.knots_u, 0)
+    iv, bv = _basis(v, piece.knots_v, 0)
+    P = piece.poles[iu[:, :, None], iv[:, None, :]]            # (k, 4, 4, 3)
 
-    def pair(A, B):                       # sparse (k, nu) basis in u, dense (k, nv) in v
-        return (np.asarray(A @ flat).reshape(len(u), nv, 3) * B.toarray()[:, :, None]).sum(1)
-    Bu, Bv = _basis(u, piece.knots_u, 0), _basis(v, piece.knots_v, 0)
+    def pair(A, B):
+        return np.einsum("ka,kb,kabc->kc", A, B, P)
     if not derivatives:
-        return pair(Bu, Bv)
-    Du, Dv = _basis(u, piece.knots_u, 1), _basis(v, piece.knots_v, 1)
-    return pair(Bu, Bv), pair(Du, Bv), pair(Bu, Dv)
+        return pair(bu, bv)
+    du, dv = _basis(u, piece.knots_u, 1)[1], _basis(v, piece.knots_v, 1)[1]
+    return pair(bu, bv), pair(du, bv), pair(bu, dv)
 
 
 def _basis(x: np.ndarray, t: np.ndarray, derivative: int):
-    """Sparse cubic B-spline basis ``(k, len(t) - 4)`` at ``x``, or its first derivative.
-
-    The derivative of a cubic with poles ``c`` is the quadratic on ``t[1:-1]`` with
-    poles ``3 (c[i + 1] - c[i]) / (t[i + 4] - t[i + 1])``.
+    """Non-zero cubic B-spline basis functions at ``x``: columns and values ``(k, 4)``,
+    or the values' first derivatives on the same columns (Cox-de Boor, Piegl &
+    Tiller, The NURBS Book, A2.2 and eq. 2.9).
     """
-    if derivative == 0:
-        return BSpline.design_matrix(x, t, 3)
+    x = np.asarray(x, np.float64)
     n = len(t) - 4
-    w = 3.0 / (t[4:n + 3] - t[1:n])
-    D = sp.diags([-w, w], [0, 1], shape=(n - 1, n))
-    return BSpline.design_matrix(x, t[1:-1], 2) @ D
+    s = np.clip(np.searchsorted(t, x, side="right") - 1, 3, n - 1)       # t[s] <= x < t[s+1]
+    left = x[:, None] - t[s[:, None] + 1 - np.arange(1, 4)]             # x - t[s + 1 - j]
+    right = t[s[:, None] + np.arange(1, 4)] - x[:, None]                # t[s + j] - x
+    N = np.ones((len(x), 1))
+    for j in range(1, 4):
+        nxt = np.zeros((len(x), j + 1))
+        for r in range(j):
+            tmp = N[:, r] / (right[:, r] + left[:, j - r - 1])
+            nxt[:, r] += right[:, r] * tmp
+            nxt[:, r + 1] = left[:, j - r - 1] * tmp
+        N = nxt
+        if j == 2:
+            quad = N                        # the quadratics, for the derivative
+    cols = s[:, None] - 3 + np.arange(4)
+    if derivative == 0:
+        return cols, N
+    # N'_(i,3) = 3 N_(i,2) / (t[i+3] - t[i]) - 3 N_(i+1,2) / (t[i+4] - t[i+1]);
+    # quad[:, b] is N_(s-2+b, 2)
+    den = t[cols + 3] - t[cols]
+    w = np.where(den > 0, 3.0 / np.where(den > 0, den, 1.0), 0.0)     # 3 / (t[i+3] - t[i])
+    q = np.zeros((len(x), 5))
+    q[:, 1:4] = quad
+    return cols, w * q[:, :4] - np.c_[w[:, 1:], np.zeros(len(x))] * q[:, 1:]
 
 
 def project(piece: BSplinePiece, points, u0, v0, iterations: int = 8):
@@ -318,8 +355,9 @@ def project(piece: BSplinePiece, points, u0, v0, iterations: int = 8):
 class _Level:
     """One subdivision level: positions, quads and the lookups the outer ring needs."""
 
-    def __init__(self, V, Q, sharp_edges):
+    def __init__(self, V, Q, sharp_edges, corners):
         self.V, self.Q = V, Q
+        self.sharp_edges, self.corners = sharp_edges, corners
         n = self.n = len(V)
         self.topo = edge_topology(Q, n)
         self.sharp = sharp_mask(self.topo, sharp_edges)
@@ -349,30 +387,29 @@ class _Level:
 
 
 def _side(lv: _Level, Gs: np.ndarray):
-    """Outer ring beside the border ``Gs[:, 0]`` (inner row ``Gs[:, 1]``).
+    """Outer ring beside the borders ``Gs[:, :, 0]`` (inner rows ``Gs[:, :, 1]``) of
+    ``k`` grids ``Gs (k, m + 1, 2)``.
 
-    Returns ``(points (m + 1, 3), ids (m + 1,), sharp (m,), conflict (m + 1,))``;
+    Returns ``(points (k, m + 1, 3), ids (k, m + 1), sharp (k, m), conflict (k, m + 1))``;
     ids are -1 for phantom points ``2 P_0 - P_1``.
     """
     V = lv.V
-    a, b = Gs[:-1, 0], Gs[1:, 0]
-    own = lv.find(a, Gs[1:, 1], b)
-    oa, ob, sharp = lv.across(a, b, own)
-    ghost = 2.0 * V[Gs[:, 0]] - V[Gs[:, 1]]
-    m = len(a)
-    right = np.r_[oa, -2]            # candidate of vertex i from edge (i, i + 1)
-    left = np.r_[-2, ob]             # ... from edge (i - 1, i)
-    sh_r = np.r_[sharp, False]
-    sh_l = np.r_[False, sharp]
-    has_r = np.r_[np.ones(m, bool), False]
-    has_l = np.r_[False, np.ones(m, bool)]
+    k, m = Gs.shape[0], Gs.shape[1] - 1
+    a, b = Gs[:, :-1, 0].ravel(), Gs[:, 1:, 0].ravel()
+    own = lv.find(a, Gs[:, 1:, 1].ravel(), b, Gs[:, :-1, 1].ravel())
+    oa, ob, sharp = (x.reshape(k, m) for x in lv.across(a, b, own))
+    ghost = 2.0 * V[Gs[:, :, 0]] - V[Gs[:, :, 1]]
+    no, yes = np.zeros((k, 1), bool), np.ones((k, m), bool)
+    right = np.concatenate([oa, np.full((k, 1), -2)], 1)   # vertex i's from edge (i, i + 1)
+    left = np.concatenate([np.full((k, 1), -2), ob], 1)    # ... from edge (i - 1, i)
+    sh_r, sh_l = np.concatenate([sharp, no], 1), np.concatenate([no, sharp], 1)
+    has_r, has_l = np.concatenate([yes, no], 1), np.concatenate([no, yes], 1)
 
     def cand(ids, sh):
-        return np.where(sh[:, None], ghost, V[np.maximum(ids, 0)])
+        return np.where(sh[..., None], ghost, V[np.maximum(ids, 0)])
     pr, pl = cand(right, sh_r), cand(left, sh_l)
-    both = has_r & has_l
-    conflict = both & ((sh_r != sh_l) | (~sh_r & (right != left)))
-    pts = np.where(has_r[:, None], pr, pl)
+    conflict = has_r & has_l & ((sh_r != sh_l) | (~sh_r & (right != left)))
+    pts = np.where(has_r[..., None], pr, pl)
     pts[conflict] = 0.5 * (pr[conflict] + pl[conflict])
     ids = np.where(has_r, np.where(sh_r, -1, right), np.where(sh_l, -1, left))
     ids[conflict] = -1
@@ -381,46 +418,54 @@ def _side(lv: _Level, Gs: np.ndarray):
 
 def _extended(lv: _Level, G: np.ndarray):
     """Uniform B-spline poles ``(M + 3, N + 3, 3)`` of a piece grid, and whether
-    every outer-ring point was found unambiguously."""
+    every outer-ring point was found unambiguously (:func:`_extended_many`)."""
+    E, clean = _extended_many(lv, G[None])
+    return E[0], bool(clean[0])
+
+
+def _extended_many(lv: _Level, G: np.ndarray):
+    """Uniform B-spline poles ``(k, M + 3, N + 3, 3)`` of grids ``G (k, M + 1, N + 1)``:
+    the grids' points and the ring of vertices just outside (phantom across sharp
+    edges); and ``clean (k,)``: every outer-ring point found unambiguously."""
     V = lv.V
-    M, N = G.shape[0] - 1, G.shape[1] - 1
-    E = np.zeros((M + 3, N + 3, 3))
-    ids = np.full((M + 3, N + 3), -1, dtype=np.int64)
-    E[1:-1, 1:-1] = V[G]
-    ids[1:-1, 1:-1] = G
-    clean = True
+    k, M, N = G.shape[0], G.shape[1] - 1, G.shape[2] - 1
+    E = np.zeros((k, M + 3, N + 3, 3))
+    ids = np.full((k, M + 3, N + 3), -1, dtype=np.int64)
+    E[:, 1:-1, 1:-1] = V[G]
+    ids[:, 1:-1, 1:-1] = G
+    clean = np.ones(k, bool)
     sharp_at = {}
-    for name, Gs, Ev, Iv in (("b", G, E[1:-1, 0], ids[1:-1, 0]),
-                             ("t", G[:, ::-1], E[1:-1, -1], ids[1:-1, -1]),
-                             ("l", G.T, E[0, 1:-1], ids[0, 1:-1]),
-                             ("r", G[::-1].T, E[-1, 1:-1], ids[-1, 1:-1])):
+    for name, Gs, Ev, Iv in (("b", G, E[:, 1:-1, 0], ids[:, 1:-1, 0]),
+                             ("t", G[:, :, ::-1], E[:, 1:-1, -1], ids[:, 1:-1, -1]),
+                             ("l", G.transpose(0, 2, 1), E[:, 0, 1:-1], ids[:, 0, 1:-1]),
+                             ("r", G[:, ::-1].transpose(0, 2, 1), E[:, -1, 1:-1],
+                              ids[:, -1, 1:-1])):
         pts, oid, sharp, conflict = _side(lv, Gs)
         Ev[:], Iv[:] = pts, oid
-        sharp_at[name] = (sharp[0], sharp[-1])
-        clean &= not conflict.any()
-    # corners: views with the corner at [0, 0]
+        sharp_at[name] = (sharp[:, 0], sharp[:, -1])
+        clean &= ~conflict.any(axis=1)
+    # corners: views with the corner at [:, 0, 0]
+    rows = np.arange(k)
     for Ev, Iv, Gv, s_j, s_i in (
             (E, ids, G, sharp_at["b"][0], sharp_at["l"][0]),
-            (E[::-1], ids[::-1], G[::-1], sharp_at["b"][1], sharp_at["r"][0]),
-            (E[:, ::-1], ids[:, ::-1], G[:, ::-1], sharp_at["t"][0], sharp_at["l"][1]),
-            (E[::-1, ::-1], ids[::-1, ::-1], G[::-1, ::-1], sharp_at["t"][1],
+            (E[:, ::-1], ids[:, ::-1], G[:, ::-1], sharp_at["b"][1], sharp_at["r"][0]),
+            (E[:, :, ::-1], ids[:, :, ::-1], G[:, :, ::-1], sharp_at["t"][0],
+             sharp_at["l"][1]),
+            (E[:, ::-1, ::-1], ids[:, ::-1, ::-1], G[:, ::-1, ::-1], sharp_at["t"][1],
              sharp_at["r"][1])):
-        if s_j:                                  # row j = -1 is phantom
-            Ev[0, 0] = 2.0 * Ev[0, 1] - Ev[0, 2]
-            continue
-        if s_i:                                  # column i = -1 is phantom
-            Ev[0, 0] = 2.0 * Ev[1, 0] - Ev[2, 0]
-            continue
-        x, y, c = Iv[0, 1], Iv[1, 0], Gv[0, 0]
-        f = lv.find(np.array([x]), np.array([y]), np.array([c]))[0] if min(x, y) >= 0 else -1
-        if f >= 0 and c in lv.Q[f]:
-            q = lv.Q[f]
-            k = int(np.flatnonzero(q == c)[0])
-            d = q[(k + 2) % 4]
-            Ev[0, 0], Iv[0, 0] = V[d], d
-        else:
-            Ev[0, 0] = Ev[0, 1] + Ev[1, 0] - Ev[1, 1]
-            clean = False
+        Ev[s_j, 0, 0] = 2.0 * Ev[s_j, 0, 1] - Ev[s_j, 0, 2]       # row j = -1 is phantom
+        col = ~s_j & s_i                                           # column i = -1 is phantom
+        Ev[col, 0, 0] = 2.0 * Ev[col, 1, 0] - Ev[col, 2, 0]
+        x, y, c = Iv[:, 0, 1], Iv[:, 1, 0], Gv[:, 0, 0]
+        f = np.where((x >= 0) & (y >= 0), lv.find(np.maximum(x, 0), np.maximum(y, 0), c), -1)
+        q = lv.Q[np.maximum(f, 0)]
+        hit = q == c[:, None]
+        found = ~s_j & ~s_i & (f >= 0) & hit.any(axis=1)
+        d = q[rows, (np.argmax(hit, axis=1) + 2) % 4]
+        Ev[found, 0, 0], Iv[found, 0, 0] = V[d[found]], d[found]
+        lost = ~s_j & ~s_i & ~found
+        Ev[lost, 0, 0] = Ev[lost, 0, 1] + Ev[lost, 1, 0] - Ev[lost, 1, 1]
+        clean &= ~lost
     return E, clean
 
 
@@ -441,8 +486,7 @@ def _level(net: ControlNet, level: int):
         find = _diag_lookup(Q, len(V))
         grids = [refine_grid(G, Q, st.topo, find) for G in grids]
         V, Q, se, cr = st.S @ V, st.quads, st.sharp_edges, st.corners
-    lv = _Level(V, Q, se)
-    lv.sharp_edges, lv.corners = se, cr
+    lv = _Level(V, Q, se, cr)
     return [p for p, _ in pieces], lv, grids, limit_matrix(Q, len(V), se, cr) @ V
 
 
@@ -453,12 +497,7 @@ def _local_samples(lv: _Level, spans: list, levels: int) -> np.ndarray:
     around them are subdivided: the limit surface over a face depends on its one-ring
     alone, so the submesh's own (sharp) border does not reach the samples.
     """
-    H = np.stack(spans)                                          # (k, 2, 2)
-    bad_faces = lv.find(H[:, 0, 0], H[:, 1, 1], H[:, 1, 0])
-    near = np.zeros(lv.n, bool)
-    near[lv.Q[bad_faces].ravel()] = True
-    Q = lv.Q[near[lv.Q].any(axis=1)]
-    V, se, cr = lv.V, lv.sharp_edges, lv.corners
+    V, Q, se, cr, H = submesh(lv, np.stack(spans))
     grids = list(H)
     for _ in range(levels):
         st = subdivision_step(Q, len(V), se, cr)
@@ -473,108 +512,146 @@ def _local_samples(lv: _Level, spans: list, levels: int) -> np.ndarray:
     return (L @ V)[lut[ids]]
 
 
-def _spans_to_samples(spans: np.ndarray, r: int) -> np.ndarray:
-    """Samples ``(r M + 1, r N + 1)`` in the closure of the marked spans ``(M, N)``."""
-    M, N = spans.shape
-    out = np.zeros((r * M + 1, r * N + 1), bool)
-    for du in range(r + 1):
-        for dv in range(r + 1):
-            out[du:du + r * M:r, dv:dv + r * N:r] |= spans
-    return out
+def _sites(lv: _Level, grids: list, offs: list, limit: np.ndarray, tol: float):
+    """One site per span with a corner off the limit.
 
+    Such a span either has one irregular corner (its own ``4 x 4`` ring still misses
+    the limit there) or none (only the piece's shared outer ring was ambiguous
+    beside an irregular border vertex; its own ring is exact).
 
-def _fit_irregular(E, Bu, Bv, S, bad_span, r):
-    """Refit the poles acting on irregular spans to the exact samples.
+    Returns
+    -------
+    sites : (k, 6) int64
+        ``piece, i, j`` (span ``[i, i + 1] x [j, j + 1]``), the irregular corner
+        ``ci, cj`` (grid vertex; -1 when none) and an index into ``corner_spans``
+        (irregular) or ``own`` (regular).
+    corner_spans : list of (2, 2) int64
+        Ids with the irregular corner at ``[0, 0]``.
+    own : (r, 4, 4, 3) float64
+        Exact uniform poles of the regular ones.
 
-    ``E (M + 3, N + 3, 3)`` uniform poles, ``Bu (r M + 1, M + 3)``, ``Bv`` design
-    matrices at the sample parameters, ``S (r M + 1, r N + 1, 3)`` exact samples,
-    ``bad_span (M, N)``. The poles whose support meets a bad span are refitted to
-    the samples over their whole support, so the spans next to the irregular ones
-    become approximate too.
+    Raises
+    ------
+    ValueError
+        If a span has several irregular corners (level 0).
     """
-    M, N = bad_span.shape
-    pad = np.zeros((M + 6, N + 6), bool)         # pole a acts on spans a - 3 .. a
-    pad[3:-3, 3:-3] = bad_span
-    free = np.zeros((M + 3, N + 3), bool)
-    for du in range(4):
-        for dv in range(4):
-            free |= pad[du:du + M + 3, dv:dv + N + 3]
-    touched = np.zeros((M + 6, N + 6), bool)
-    for du in range(4):
-        for dv in range(4):
-            touched[du:du + M + 3, dv:dv + N + 3] |= free
-    rows = np.argwhere(_spans_to_samples(touched[3:-3, 3:-3], r))
-    fr = np.argwhere(free)
-    Efix = E.copy()
-    Efix[fr[:, 0], fr[:, 1]] = 0.0
-    fixed = _tensor(Bu, Efix, Bv)[rows[:, 0], rows[:, 1]]
-    A = Bu[rows[:, 0]][:, fr[:, 0]] * Bv[rows[:, 1]][:, fr[:, 1]]
-    X = np.linalg.lstsq(A, S[rows[:, 0], rows[:, 1]] - fixed, rcond=None)[0]
-    E = E.copy()
-    E[fr[:, 0], fr[:, 1]] = X
-    return E
+    w = np.array([1.0, 4.0, 1.0]) / 6.0
+    irregular = _irregular(lv)
+    where = [(pid, i, j) for pid, off in enumerate(offs)
+             for i, j in np.argwhere(off[:-1, :-1] | off[1:, :-1] | off[:-1, 1:] | off[1:, 1:])]
+    if not where:
+        return np.zeros((0, 6), np.int64), [], np.zeros((0, 4, 4, 3))
+    spans = np.array([grids[p][i:i + 2, j:j + 2] for p, i, j in where])
+    E4s = _extended_many(lv, spans)[0]
+    at = np.stack([np.stack([np.einsum("a,b,kabc->kc", w, w, E4s[:, a:a + 3, b:b + 3])
+                             for b in (0, 1)], 1) for a in (0, 1)], 1)
+    offc = np.linalg.norm(at - limit[spans], axis=3) > tol
+    rows, corner_spans, own = [], [], []
+    for (pid, i, j), S, E4, oc in zip(where, spans, E4s, offc):
+        corner = np.argwhere(oc)
+        if len(corner) > 1:                  # a ring shared with another vertex
+            corner = corner[irregular[S[corner[:, 0], corner[:, 1]]]]
+        if len(corner) > 1:
+            raise ValueError(f"piece {pid}: span ({i}, {j}) has several irregular "
+                             f"corners; subdivide at least once (level >= 1)")
+        if len(corner):
+            a, b = corner[0]
+            rows.append((pid, i, j, i + a, j + b, len(corner_spans)))
+            corner_spans.append(S[::1 - 2 * a, ::1 - 2 * b])
+        else:
+            rows.append((pid, i, j, -1, -1, len(own)))
+            own.append(E4)
+    return (np.array(rows, np.int64).reshape(-1, 6), corner_spans,
+            np.array(own).reshape(-1, 4, 4, 3))
 
 
-def extract_bsplines(net: ControlNet, level: int = DEFAULT_LEVEL, *,
-                     sample_levels: int = 2) -> BSplineSet:
+def _irregular(lv: _Level) -> np.ndarray:
+    """Vertices whose limit rule is not the uniform bicubic one: valence other than
+    four (smooth), darts, creases with other than two faces a side, corners of more
+    than one face."""
+    cls = vertex_classes(lv.topo, lv.sharp, lv.corners)
+    val = np.bincount(lv.topo.edges.ravel(), minlength=lv.n)
+    n_sharp = np.bincount(lv.topo.edges[lv.sharp].ravel(), minlength=lv.n)
+    regular = (((cls == SMOOTH) & (val == 4) & (n_sharp == 0))
+               | ((cls == CREASE) & ((val == 3) | (val == 4))) | ((cls == CORNER) & (val == 2)))
+    return ~regular
+
+
+def _exact_in(sites, chains, own, pid: int, M: int, N: int):
+    """``exact(u, v)``: limit points at parameters of piece ``pid`` in its sites' spans."""
+    at = np.full((M, N), -1, np.int64)
+    mine = np.flatnonzero(sites[:, 0] == pid)
+    at[sites[mine, 1], sites[mine, 2]] = mine
+
+    def exact(u, v):
+        k = at[np.clip(np.floor(u).astype(np.int64), 0, M - 1),
+               np.clip(np.floor(v).astype(np.int64), 0, N - 1)]
+        s = sites[k]
+        ev = s[:, 3] >= 0
+        out = np.empty((len(k), 3))
+        out[ev] = chains.limit(s[ev, 5], np.abs(u[ev] - s[ev, 3]), np.abs(v[ev] - s[ev, 4]))
+        out[~ev] = span_points(own[s[~ev, 5]], u[~ev] - s[~ev, 1], v[~ev] - s[~ev, 2])
+        return out
+    return exact
+
+
+def extract_bsplines(net: ControlNet, level: int = DEFAULT_LEVEL, *, sample_levels: int = 2,
+                     grade: int = DEFAULT_GRADE, max_grade: int = MAX_GRADE,
+                     tolerance: float = DEFAULT_TOLERANCE) -> BSplineSet:
     """Bicubic B-spline pieces of the limit surface of ``net``, with a seam report.
 
     Parameters
     ----------
     net : ControlNet
     level : int
-        Subdivision steps before reading off the pieces (>= 0); each piece has
-        ``(2^level p + 3) x (2^level q + 3)`` poles. Higher levels shrink the
-        irregular spans around extraordinary vertices.
+        Subdivision steps before reading off the pieces (>= 1); a regular piece has
+        ``(2^level p + 3) x (2^level q + 3)`` poles.
     sample_levels : int
-        Further steps for the exact limit samples that every deviation is measured
-        at (``(2^sample_levels + 1)^2`` per span); irregular spans are fitted to every
-        other sample (one level coarser), so the measure also sees the fit between
-        its points.
+        Exact limit samples per cell side: ``2^sample_levels`` (the deviation is
+        measured there); irregular pieces are fitted to every other sample, so the
+        measure also sees the fit between its points.
+    grade : int
+        Knots ``i +- 2^-k`` (``k = 1 .. grade``) around each irregular vertex
+        (:mod:`.graded`): the approximated corner cell has side ``2^-grade`` span,
+        and each irregular vertex adds ``2 grade`` poles per direction.
+    max_grade : int
+        A piece whose deviation exceeds ``tolerance`` is refitted with one more
+        grade at a time up to this (high valences shrink slowly under subdivision).
+    tolerance : float
+        Target deviation, fraction of the diagonal.
 
     Returns
     -------
     BSplineSet
     """
     from .seams import border_samples, seam_report    # imports this module
-    if int(level) != level or level < 0:
-        raise ValueError(f"level: expected an integer >= 0, got {level!r}")
-    if int(sample_levels) != sample_levels or sample_levels < 2:
-        raise ValueError(f"sample_levels: expected an integer >= 2, got {sample_levels!r}")
+    for name, val, lo in (("level", level, 1), ("sample_levels", sample_levels, 2),
+                          ("grade", grade, 0), ("max_grade", max_grade, grade)):
+        if int(val) != val or val < lo:
+            raise ValueError(f"{name}: expected an integer >= {lo}, got {val!r}")
     diag = net.diagonal if net.diagonal > 0 else 1.0
     patches, lv, grids, limit = _level(net, int(level))
     r = 2 ** int(sample_levels)
-    nets, bad_spans, todo = [], [], []
-    for G in grids:                    # uniform poles; irregular spans: corners off the limit
+    nets, offs = [], []
+    for G in grids:                    # uniform poles; irregular: vertices off the limit
         M, N = G.shape[0] - 1, G.shape[1] - 1
         E, clean = _extended(lv, G)
         at = _tensor(_design(np.arange(M + 1), M), E, _design(np.arange(N + 1), N))
-        off = np.linalg.norm(at - limit[G], axis=2) > EXACT_TOL * diag
-        bad = off[:-1, :-1] | off[1:, :-1] | off[:-1, 1:] | off[1:, 1:]
         nets.append((E, clean))
-        bad_spans.append(bad)
-        todo += [G[i:i + 2, j:j + 2] for i, j in np.argwhere(bad)]
-    exact_samples = iter(_local_samples(lv, todo, int(sample_levels)) if todo else ())
+        offs.append(np.linalg.norm(at - limit[G], axis=2) > EXACT_TOL * diag)
+    fitted = _fit_irregular(lv, grids, nets, offs, limit, diag, int(sample_levels),
+                            int(grade), int(max_grade), tolerance)
     pieces, border = [], []
-    for pid, (patch, G, (E, clean), bad) in enumerate(zip(patches, grids, nets, bad_spans)):
+    for pid, (patch, G, (E, clean)) in enumerate(zip(patches, grids, nets)):
         M, N = G.shape[0] - 1, G.shape[1] - 1
-        exact = not bad.any()
-        err = np.zeros((r * M + 1, r * N + 1))
-        if not exact:
-            u, v = np.arange(r * M + 1) / r, np.arange(r * N + 1) / r
-            Bu, Bv = _design(u, M), _design(v, N)
-            S = _tensor(Bu, E, Bv)            # exact on regular spans
-            for i, j in np.argwhere(bad):
-                S[i * r:(i + 1) * r + 1, j * r:(j + 1) * r + 1] = next(exact_samples)
-            E = _fit_irregular(E, Bu[::2], Bv[::2], S[::2, ::2], bad, r // 2)
-            err = np.linalg.norm(_tensor(Bu, E, Bv) - S, axis=2)
-        poles, ku = clamp_uniform(E, M, 0)
-        poles, kv = clamp_uniform(poles, N, 1)
-        pc = BSplinePiece(poles, ku, kv, int(patch), exact and clean, 0.0)
-        if not exact:                    # distance to the surface, not to the same (u, v)
-            i, j = np.nonzero(_spans_to_samples(bad, r))
-            err[i, j] = np.minimum(err[i, j], project(pc, S[i, j], u[i], v[j])[2])
-        pc.deviation = float(err.max() / diag)
+        if pid in fitted:
+            poles, ku, kv, err, dev, _ = fitted[pid]
+            pc = BSplinePiece(poles, ku, kv, int(patch), False, dev / diag)
+        else:
+            poles, ku = clamp_uniform(E, M, 0)
+            poles, kv = clamp_uniform(poles, N, 1)
+            pc = BSplinePiece(poles, ku, kv, int(patch), clean, 0.0)
+            err = np.zeros((r * M + 1, r * N + 1))
         pieces.append(pc)
         border.append(border_samples(pid, G, r, err / diag, lv.n))
     seams = seam_report(pieces, border, net)
@@ -582,8 +659,41 @@ def extract_bsplines(net: ControlNet, level: int = DEFAULT_LEVEL, *,
     per_patch: dict = {}
     for p in pieces:
         per_patch[p.patch] = per_patch.get(p.patch, 0) + 1
-    report = {"level": int(level), "sample_levels": int(sample_levels), "diagonal": diag,
-              "n_pieces": len(pieces), "n_exact": sum(p.exact for p in pieces),
-              "max_deviation": float(dev),
+    grades = [f[5] for f in fitted.values()]
+    report = {"level": int(level), "sample_levels": int(sample_levels), "grade": int(grade),
+              "grades_used": sorted(set(grades)), "diagonal": diag, "n_pieces": len(pieces),
+              "n_exact": sum(p.exact for p in pieces), "max_deviation": float(dev),
               "pieces_per_patch": {int(k): int(c) for k, c in per_patch.items() if c > 1}}
     return BSplineSet(pieces, seams, report)
+
+
+def _fit_irregular(lv, grids, nets, offs, limit, diag, sample_levels, grade, max_grade,
+                   tolerance) -> dict:
+    """Graded fits of the pieces with irregular spans: ``{piece: (poles, knots_u,
+    knots_v, err, deviation, grade)}`` (:func:`graded.fit_graded`, model units);
+    pieces above ``tolerance`` are refitted with more grades, on deeper chains."""
+    sites, spans, own = _sites(lv, grids, offs, limit, EXACT_TOL * diag)
+    if not len(sites):
+        return {}
+
+    def fit(pid, g, at, chains):
+        M, N = grids[pid].shape[0] - 1, grids[pid].shape[1] - 1
+        mine = at[(at[:, 0] == pid) & (at[:, 3] >= 0)]
+        return fit_graded(nets[pid][0], offs[pid], mine[:, 3:5],
+                          _exact_in(at, chains, own, pid, M, N), grade=g,
+                          r=2 ** sample_levels, tol=EXACT_TOL * diag) + (g,)
+    chains = corner_chains(lv, np.stack(spans), grade, sample_levels) if spans else None
+    fitted = {pid: fit(pid, grade, sites, chains) for pid in np.unique(sites[:, 0]).tolist()}
+    over = [pid for pid, f in fitted.items() if f[4] > tolerance * diag]
+    sel = np.flatnonzero(np.isin(sites[:, 0], over) & (sites[:, 3] >= 0))
+    if max_grade > grade and len(sel):
+        deep_sites = sites.copy()
+        deep_sites[sel, 5] = np.arange(len(sel))
+        deep = corner_chains(lv, np.stack([spans[k] for k in sites[sel, 5]]), max_grade,
+                             sample_levels)
+        for pid in over:
+            for g in range(grade + 1, max_grade + 1):
+                fitted[pid] = fit(pid, g, deep_sites, deep)
+                if fitted[pid][4] <= tolerance * diag:
+                    break
+    return fitted

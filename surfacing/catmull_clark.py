@@ -30,6 +30,7 @@ curve as its boundary (cubic B-spline rule along the curve).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 import scipy.sparse as sp
@@ -61,7 +62,7 @@ class EdgeTopology:
     face_count: np.ndarray
     n_vertices: int
 
-    @property
+    @cached_property
     def keys(self) -> np.ndarray:
         return self.edges[:, 0] * self.n_vertices + self.edges[:, 1]
 
