@@ -171,13 +171,27 @@ def _free_edges(shape) -> int:
     return _count(fb.GetOpenWires(), TopAbs_EDGE) + _count(fb.GetClosedWires(), TopAbs_EDGE)
 
 
+def _valid(shape) -> bool:
+    from OCP.BRepCheck import BRepCheck_Analyzer
+    return bool(BRepCheck_Analyzer(shape).IsValid())
+
+
+def _fix(shape):
+    """``ShapeFix_Shape``: edge and vertex tolerances raised to the real distances
+    between the sewn faces' borders (fitted pieces meet within their deviation, not
+    exactly), same-parameter flags recomputed."""
+    from OCP.ShapeFix import ShapeFix_Shape
+    fx = ShapeFix_Shape(shape)
+    fx.Perform()
+    return fx.Shape()
+
+
 def shape_report(shape) -> dict:
     """Faces, shells, solids, free edges and validity of a B-rep shape."""
-    from OCP.BRepCheck import BRepCheck_Analyzer
     from OCP.TopAbs import TopAbs_FACE, TopAbs_SHELL, TopAbs_SOLID
     return {"faces": _count(shape, TopAbs_FACE), "shells": _count(shape, TopAbs_SHELL),
             "solids": _count(shape, TopAbs_SOLID), "free_edges": _free_edges(shape),
-            "valid": bool(BRepCheck_Analyzer(shape).IsValid())}
+            "valid": _valid(shape)}
 
 
 def write_step(path, bset, *, schema: str = "AP214") -> dict:
@@ -207,8 +221,12 @@ def write_step(path, bset, *, schema: str = "AP214") -> dict:
     tol = max(SEW_TOL, 2.0 * gap) * diag
     groups = manifold_groups(len(bset.pieces), bset.seams)
     shape, free = sew(occ_faces(bset.pieces), tol, groups)
+    fixed = not _valid(shape)
+    if fixed:
+        shape = _fix(shape)
     STEPControl_Controller.Init_s()              # registers the parameter the schema sets
     Interface_Static.SetCVal_s("write.step.schema", STEP_SCHEMAS[schema])
+    Interface_Static.SetIVal_s("write.precision.mode", 1)   # uncertainty: largest tolerance
     writer = STEPControl_Writer()
     writer.Transfer(shape, STEPControl_AsIs)
     path = Path(path)
@@ -217,7 +235,7 @@ def write_step(path, bset, *, schema: str = "AP214") -> dict:
             raise OSError(f"{path}: the STEP writer failed")
     rep = shape_report(shape)
     rep.update(sew_tolerance=float(tol), sewing_free_edges=free, schema=schema,
-               manifold_pieces=len(groups))
+               manifold_pieces=len(groups), shape_fixed=fixed)
     return rep
 
 
