@@ -194,7 +194,7 @@ def shape_report(shape) -> dict:
             "valid": _valid(shape)}
 
 
-def write_step(path, bset, *, schema: str = "AP214") -> dict:
+def write_step(path, bset, *, schema: str = "AP214", wires=()) -> dict:
     """Write the pieces of ``bset`` (:class:`surfacing.bspline.BSplineSet`) as STEP.
 
     Parameters
@@ -202,6 +202,8 @@ def write_step(path, bset, *, schema: str = "AP214") -> dict:
     path : str or os.PathLike
     bset : BSplineSet
     schema : {"AP214", "AP242"}
+    wires : list of (m, 3) float64
+        Polylines written as edges beside the faces.
 
     Returns
     -------
@@ -224,6 +226,7 @@ def write_step(path, bset, *, schema: str = "AP214") -> dict:
     fixed = not _valid(shape)
     if fixed:
         shape = _fix(shape)
+    shape = _with_wires(shape, wires)
     STEPControl_Controller.Init_s()              # registers the parameter the schema sets
     Interface_Static.SetCVal_s("write.step.schema", STEP_SCHEMAS[schema])
     Interface_Static.SetIVal_s("write.precision.mode", 1)   # uncertainty: largest tolerance
@@ -235,8 +238,27 @@ def write_step(path, bset, *, schema: str = "AP214") -> dict:
             raise OSError(f"{path}: the STEP writer failed")
     rep = shape_report(shape)
     rep.update(sew_tolerance=float(tol), sewing_free_edges=free, schema=schema,
-               manifold_pieces=len(groups), shape_fixed=fixed)
+               manifold_pieces=len(groups), shape_fixed=fixed, wires=len(wires))
     return rep
+
+
+def _with_wires(shape, wires):
+    """``shape`` and one polyline wire per ``(m, 3)`` array, in a compound."""
+    if not len(wires):
+        return shape
+    from OCP.BRep import BRep_Builder
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakePolygon
+    from OCP.gp import gp_Pnt
+    from OCP.TopoDS import TopoDS_Compound
+    comp, bld = TopoDS_Compound(), BRep_Builder()
+    bld.MakeCompound(comp)
+    bld.Add(comp, shape)
+    for w in wires:
+        poly = BRepBuilderAPI_MakePolygon()
+        for x, y, z in np.asarray(w, np.float64).tolist():
+            poly.Add(gp_Pnt(x, y, z))
+        bld.Add(comp, poly.Wire())
+    return comp
 
 
 def read_step(path):
@@ -252,13 +274,14 @@ def read_step(path):
     return rd.OneShape()
 
 
-def write_3dm(path, bset) -> dict:
-    """Write the pieces of ``bset`` as NURBS surfaces in a Rhino 3DM file.
+def write_3dm(path, bset, *, wires=()) -> dict:
+    """Write the pieces of ``bset`` as NURBS surfaces in a Rhino 3DM file, and
+    ``wires`` (list of ``(m, 3)`` polylines) as polyline curves.
 
     Returns
     -------
     dict
-        ``faces``: surfaces written.
+        ``faces``: surfaces written, ``wires``: polylines written.
     """
     rhino3dm = require_cad(".3dm")
     model = rhino3dm.File3dm()
@@ -271,19 +294,25 @@ def write_3dm(path, bset) -> dict:
             for i, x in enumerate(t.tolist()):
                 kv[i] = x
         model.Objects.AddSurface(srf)
+    for w in wires:
+        model.Objects.AddPolyline([rhino3dm.Point3d(*p) for p in np.asarray(w, float).tolist()])
     path = Path(path)
     with atomic_path(path) as tmp:
         if not model.Write(str(tmp), 7):
             raise OSError(f"{path}: the 3DM writer failed")
-    return {"faces": len(bset.pieces)}
+    return {"faces": len(bset.pieces), "wires": len(wires)}
 
 
-def write_cad(path, bset, *, schema: str = "AP214") -> dict:
-    """Write STEP or 3DM by the extension of ``path``; returns the writer's report."""
+def write_cad(path, bset, *, schema: str = "AP214", wires=()) -> dict:
+    """Write STEP or 3DM by the extension of ``path``; returns the writer's report.
+
+    ``wires`` (list of ``(m, 3)`` polylines: curves that bound no surface) are written
+    beside the faces as polyline edges (STEP) or polyline curves (3DM).
+    """
     suffix = Path(path).suffix.lower()
     if suffix not in CAD_FORMATS:
         raise InvalidParameterError(f"output {path}: {suffix!r} is not one of {CAD_FORMATS}")
     require_cad(suffix)
     if suffix == ".3dm":
-        return write_3dm(path, bset)
-    return write_step(path, bset, schema=schema)
+        return write_3dm(path, bset, wires=wires)
+    return write_step(path, bset, schema=schema, wires=wires)

@@ -150,9 +150,16 @@ def export_cad(path, result: SurfaceResult, *, schema: str = "AP214",
         raise InvalidParameterError(
             f"output {path}: CAD export needs the classical Catmull-Clark route "
             f"(this surface came from {result.method})")
+    foreign = (np.asarray(result.routes)[result.face_route] != "classical"
+               if result.face_route is not None and len(result.routes) else np.zeros(0, bool))
+    if foreign.any():
+        raise InvalidParameterError(
+            f"output {path}: {int(foreign.sum())} faces came from the "
+            f"neural fill (a mesh, no B-spline form) and cannot be written as CAD faces; "
+            f"save a mesh format or surface with --method classical")
     from curvenet.surfacing.bspline import DEFAULT_LEVEL, extract_bsplines
     bset = extract_bsplines(result.control_net, DEFAULT_LEVEL if level is None else level)
-    file_report = cad.write_cad(path, bset, schema=schema)
+    file_report = cad.write_cad(path, bset, schema=schema, wires=result.wires)
     return {"pieces": bset.report, "seams": bset.seams, "file": file_report}
 
 

@@ -31,6 +31,45 @@ def test_neural_or_soapfilm_result_refuses_cad(tmp_path):
         res.save(tmp_path / "x.step")
 
 
+def test_hybrid_result_with_neural_faces_refuses_cad_in_one_line(tmp_path, capsys):
+    pytest.importorskip("OCP")
+    from curvenet.errors import InvalidParameterError
+    res = surface(shapes.box().sketch(), method="classical")
+    n = len(res.mesh.faces)
+    res.routes, res.face_route = ("classical", "neural"), (np.arange(n) >= n - 5).astype(np.uint8)
+    with pytest.raises(InvalidParameterError, match="5 faces came from the neural fill") as err:
+        res.save(tmp_path / "x.step")
+    assert "\n" not in str(err.value) and not (tmp_path / "x.step").exists()
+
+
+def test_wires_are_written_beside_the_faces(tmp_path):
+    rhino3dm = pytest.importorskip("rhino3dm")
+    pytest.importorskip("OCP")
+    from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE
+    from OCP.TopExp import TopExp_Explorer
+
+    from curvenet import cad
+    res = surface(shapes.box().sketch(), method="classical")
+    wire = np.array([[2.0, 0, 0], [2.5, 0.2, 0], [3.0, 0, 0.1], [3.2, 0.4, 0.3]])
+    res.routes, res.face_route = ("classical",), np.zeros(len(res.mesh.faces), np.uint8)
+    res.wires = [wire]
+    res.save(tmp_path / "w.step")
+    assert res.diagnostics["cad"]["file"]["wires"] == 1
+    shape = cad.read_step(tmp_path / "w.step")
+    exp, loose = TopExp_Explorer(shape, TopAbs_EDGE, TopAbs_FACE), 0
+    while exp.More():
+        loose += 1
+        exp.Next()
+    assert loose == len(wire) - 1 and cad.shape_report(shape)["faces"] == 6
+    res.save(tmp_path / "w.3dm")
+    objs = [o.Geometry for o in rhino3dm.File3dm.Read(str(tmp_path / "w.3dm")).Objects]
+    curves = [g for g in objs if isinstance(g, rhino3dm.PolylineCurve)]
+    assert len(objs) == 7 and len(curves) == 1
+    pts = np.array([[p.X, p.Y, p.Z] for p in (curves[0].Point(i)
+                                              for i in range(curves[0].PointCount))])
+    assert np.allclose(pts, wire)
+
+
 def _face_points(shape, n=5):
     """Points of every face of a read-back shape on an n x n parameter grid."""
     from OCP.BRep import BRep_Tool
@@ -112,6 +151,20 @@ def test_irregular_shapes_graded_pieces_valid_and_close(tmp_path, make):
     smooth = [s["angle"] for s in rep["seams"] if not s["crease"]]
     assert max(smooth, default=0.0) < 1.0
     assert 0 < pieces["max_deviation"] < 2e-5 and pieces["n_exact"] < pieces["n_pieces"]
+
+
+def test_faces_with_holes_export_as_their_sectors(tmp_path):
+    """A washer's annular faces are cut into sectors (surfacing.holes): one B-spline
+    face per sector grid, the cuts are shared edges, the solid closes."""
+    pytest.importorskip("OCP")
+    from curvenet import cad
+    res = surface(shapes.washer().sketch(), method="classical")
+    res.save(tmp_path / "w.step")
+    rep = res.diagnostics["cad"]
+    back = cad.shape_report(cad.read_step(tmp_path / "w.step"))
+    assert back["valid"] and back["solids"] == 1 and back["free_edges"] == 0
+    assert back["faces"] == rep["pieces"]["n_pieces"] > len(res.patchset.patches)
+    assert rep["pieces"]["max_deviation"] < 1e-4
 
 
 @pytest.mark.parametrize("make", [shapes.torus, shapes.l_prism])
