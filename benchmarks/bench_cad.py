@@ -4,12 +4,14 @@ For every analytic shape of ``curvenet.shapes`` and every public network in
 ``$CURVENET_DATA/networks`` (default ``../shared/data``): surface it on the classical
 route, export STEP, read it back with OpenCascade and print
 
-* patches, B-spline faces (pieces) and how many are exact;
-* validity (``BRepCheck_Analyzer``), free edges of the read-back shape against the
-  network's open-boundary curves (curves used by one patch), solids;
+* patches, B-spline faces (pieces) and how many are exact, the most pieces of one
+  patch (patches split around a centre), the largest knot grading used;
+* validity (``BRepCheck_Analyzer``), free edges of the read-back shape and whether
+  every one lies on the network's open boundary (curves used by one patch), solids;
 * the largest deviation of the B-spline faces from the limit surface (fraction of the
   diagonal; exact limit points one level finer than the fit), the largest seam gap
-  (G0) and the largest normal angle across non-crease seams (G1, degrees);
+  (G0) and the largest normal angle across non-crease seams (G1, degrees), along
+  the seams and at the faces' corners;
 * export seconds (B-spline extraction + sewing + writing).
 
 Then the export time of a 100-patch network (a 10 x 10 saddle grid; target < 10 s).
@@ -34,17 +36,44 @@ from curvenet import cad, shapes  # noqa: E402
 from curvenet.errors import CurvenetError  # noqa: E402
 from curvenet.pipeline import surface  # noqa: E402
 
-HEADER = (f"{'input':<28s} {'patches':>7s} {'faces':>5s} {'exact':>5s} {'valid':>5s} "
-          f"{'free':>5s} {'open':>5s} {'solid':>5s} {'deviation':>9s} {'gap':>8s} "
-          f"{'G1 deg':>7s} {'export s':>8s}")
+HEADER = (f"{'input':<28s} {'patches':>7s} {'faces':>5s} {'exact':>5s} {'/patch':>6s} "
+          f"{'grade':>5s} {'valid':>5s} {'free':>5s} {'on open':>7s} {'solid':>5s} "
+          f"{'deviation':>9s} {'gap':>8s} {'G1 deg':>7s} {'corner':>7s} {'export s':>8s}")
 
 
-def _open_curves(res) -> int:
+def _open_curves(res) -> list:
+    """Polylines of the curves used by one patch only."""
     uses = np.zeros(len(res.network.edges), int)
     for p in res.patchset.patches:
         for e in p.edges:
             uses[e] += 1
-    return int((uses == 1).sum())
+    return [res.network.edges[i].curve for i in np.flatnonzero(uses == 1)]
+
+
+def _free_on_open(shape, curves, diag) -> bool:
+    """Whether every free edge of ``shape`` runs along one of ``curves`` (its points
+    within 1e-3 of the diagonal of their dense samples)."""
+    from OCP.BRepAdaptor import BRepAdaptor_Curve
+    from OCP.ShapeAnalysis import ShapeAnalysis_FreeBounds
+    from OCP.TopAbs import TopAbs_EDGE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+    from scipy.spatial import cKDTree
+    fb = ShapeAnalysis_FreeBounds(shape, 1e-7)
+    pts = []
+    for wires in (fb.GetOpenWires(), fb.GetClosedWires()):
+        exp = TopExp_Explorer(wires, TopAbs_EDGE)
+        while exp.More():
+            c = BRepAdaptor_Curve(TopoDS.Edge(exp.Current()))
+            ts = np.linspace(c.FirstParameter(), c.LastParameter(), 5)
+            pts += [[p.X(), p.Y(), p.Z()] for p in (c.Value(t) for t in ts)]
+            exp.Next()
+    if not pts:
+        return True
+    if not curves:
+        return False
+    dense = np.concatenate([np.linspace(c[:-1], c[1:], 20).reshape(-1, 3) for c in curves])
+    return bool(cKDTree(dense).query(np.array(pts))[0].max() < 1e-3 * diag)
 
 
 def run_one(name, source, tmp) -> str:
@@ -57,14 +86,19 @@ def run_one(name, source, tmp) -> str:
     res.save(path)
     dt = time.perf_counter() - t
     rep = res.diagnostics["cad"]
-    back = cad.shape_report(cad.read_step(path))
+    shape = cad.read_step(path)
+    back = cad.shape_report(shape)
     pr, seams = rep["pieces"], rep["seams"]
     smooth = [s["angle"] for s in seams if not s["crease"]]
+    corners = [s["corner_angle"] for s in seams if not s["crease"]]
     gap = max((s["gap"] for s in seams), default=0.0)
+    on_open = _free_on_open(shape, _open_curves(res), pr["diagonal"])
+    split = max(pr["pieces_per_patch"].values(), default=1)
     return (f"{name:<28s} {len(res.patchset.patches):>7d} {back['faces']:>5d} "
-            f"{pr['n_exact']:>5d} {str(back['valid']):>5s} {back['free_edges']:>5d} "
-            f"{_open_curves(res):>5d} {back['solids']:>5d} {pr['max_deviation']:>9.1e} "
-            f"{gap:>8.1e} {max(smooth, default=0.0):>7.2f} {dt:>8.2f}")
+            f"{pr['n_exact']:>5d} {split:>6d} {max(pr['grades_used'], default=0):>5d} "
+            f"{str(back['valid']):>5s} {back['free_edges']:>5d} {str(on_open):>7s} "
+            f"{back['solids']:>5d} {pr['max_deviation']:>9.1e} {gap:>8.1e} "
+            f"{max(smooth, default=0.0):>7.2f} {max(corners, default=0.0):>7.2f} {dt:>8.2f}")
 
 
 def main(argv=None) -> int:

@@ -286,7 +286,8 @@ def _cad_lines(cad: dict) -> list:
     """``--explain`` lines of a CAD export: pieces, file check, the worst seams."""
     pr, fr = cad["pieces"], cad["file"]
     lines = [f"cad: {pr['n_pieces']} B-spline faces ({pr['n_exact']} exact, level "
-             f"{pr['level']}), max deviation {pr['max_deviation']:.2e} of the diagonal"]
+             f"{pr['level']}, graded {max(pr['grades_used'], default=0)}), max deviation "
+             f"{pr['max_deviation']:.2e} of the diagonal"]
     if "valid" in fr:
         lines.append(f"cad: {fr['shells']} shells, {fr['solids']} solids, {fr['free_edges']} "
                      f"free edges, valid {fr['valid']}, sewing tolerance "
@@ -295,7 +296,9 @@ def _cad_lines(cad: dict) -> list:
     smooth = [s for s in seams if not s["crease"]]
     lines.append(f"cad: {len(seams)} seams ({len(seams) - len(smooth)} creases), largest G0 gap "
                  f"{max((s['gap'] for s in seams), default=0.0):.1e} of the diagonal, largest "
-                 f"G1 angle off creases {max((s['angle'] for s in smooth), default=0.0):.2f} deg")
+                 f"G1 angle off creases {max((s['angle'] for s in smooth), default=0.0):.2f} deg"
+                 f" ({max((s['corner_angle'] for s in smooth), default=0.0):.2f} at face "
+                 f"corners)")
     for s in sorted(smooth, key=lambda s: -s["angle"])[:_SEAMS_SHOWN]:
         lines.append(f"seam patches {s['patches'][0]}-{s['patches'][1]} curves {s['curves']}: "
                      f"G0 {s['gap']:.1e}, G1 {s['angle']:.2f} deg, deviation "

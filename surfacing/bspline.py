@@ -113,11 +113,14 @@ class BSplineSet:
         it), ``flipped`` (the two faces are oriented oppositely; ``angle`` is then
         taken between one normal and the other's opposite), ``gap`` (G0, largest
         distance of one border to the other face, fraction of the diagonal),
-        ``angle`` (G1, largest normal angle, degrees), ``deviation`` (largest
+        ``angle`` (G1, largest normal angle along it, degrees, the pieces' corners
+        left out), ``corner_angle`` (at the pieces' corners: a corner vertex or a
+        tangential corner is not a G1 property of the seam), ``deviation`` (largest
         distance of exact limit points along it to the faces).
     report : dict
-        ``level``, ``sample_levels``, ``diagonal`` (model units), ``n_pieces``,
-        ``n_exact``, ``max_deviation``, ``pieces_per_patch`` (patches of more than one
+        ``level``, ``sample_levels``, ``grade``, ``grades_used``, ``diagonal`` (model
+        units), ``n_pieces``, ``n_exact``, ``max_deviation``, ``pieces_per_patch``
+        (patches of more than one
         piece).
     """
 

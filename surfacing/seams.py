@@ -19,7 +19,7 @@ def _nanmax(a: np.ndarray) -> float:
 
 
 def border_samples(pid: int, G: np.ndarray, r: int, err: np.ndarray, n: int):
-    """Keys, parameters and errors of a piece's border samples.
+    """Keys, parameters, errors and piece-corner flags of a piece's border samples.
 
     A sample at fraction ``f / r`` of the level's border edge ``(a, b)`` has the key
     ``(min, max, f)`` (``f`` counted from ``min``), a sample at a vertex ``(a, a, 0)``:
@@ -43,7 +43,13 @@ def border_samples(pid: int, G: np.ndarray, r: int, err: np.ndarray, n: int):
     key, ii, jj = (np.concatenate(x) for x in zip(*out))
     key, first = np.unique(key, return_index=True)
     ii, jj = ii[first], jj[first]
-    return (np.full(len(key), pid), key, ii / r, jj / r, err[ii, jj])
+    corner = ((ii == 0) | (ii == r * M)) & ((jj == 0) | (jj == r * N))
+    return (np.full(len(key), pid), key, ii / r, jj / r, err[ii, jj], corner)
+
+
+#: Normals where ``du`` and ``dv`` are closer than this (sine of their angle, about 3
+#: degrees) are left out of G1: tangential patch corners, where ``du x dv`` is noise.
+MIN_SINE = 0.05
 
 
 def _normals(piece: BSplinePiece, u, v):
@@ -51,14 +57,14 @@ def _normals(piece: BSplinePiece, u, v):
     P, du, dv = evaluate(piece, u, v, derivatives=True)
     n = np.cross(du, dv)
     ln = np.linalg.norm(n, axis=1, keepdims=True)
-    ok = ln > 1e-6 * np.linalg.norm(du, axis=1, keepdims=True) * np.linalg.norm(dv, axis=1,
-                                                                                   keepdims=True)
+    ok = ln > MIN_SINE * np.linalg.norm(du, axis=1, keepdims=True) * np.linalg.norm(
+        dv, axis=1, keepdims=True)
     return P, np.where(ok, n / np.maximum(ln, 1e-300), np.nan)
 
 
 def seam_report(pieces: list, border: list, net: ControlNet) -> list:
     """Continuity report of every pair of pieces sharing at least one border segment."""
-    pid, vid, u, v, err = (np.concatenate(x) for x in zip(*border))
+    pid, vid, u, v, err, corner = (np.concatenate(x) for x in zip(*border))
     P = np.empty((len(pid), 3))
     Nrm = np.empty((len(pid), 3))
     for k, piece in enumerate(pieces):
@@ -66,6 +72,7 @@ def seam_report(pieces: list, border: list, net: ControlNet) -> list:
         P[m], Nrm[m] = _normals(piece, u[m], v[m])
     order = np.lexsort((pid, vid))
     pid, vid, P, Nrm, err = pid[order], vid[order], P[order], Nrm[order], err[order]
+    corner = corner[order]
     u, v = u[order], v[order]
     starts = np.flatnonzero(np.r_[True, vid[1:] != vid[:-1]])
     counts = np.diff(np.r_[starts, len(vid)])
@@ -88,6 +95,7 @@ def seam_report(pieces: list, border: list, net: ControlNet) -> list:
     gap /= max(net.diagonal, 1e-300)
     cos = np.einsum("ij,ij->i", Nrm[pr[:, 0]], Nrm[pr[:, 1]])
     ang = np.degrees(np.arccos(np.clip(cos, -1.0, 1.0)))     # NaN where degenerate
+    at_corner = corner[pr[:, 0]] | corner[pr[:, 1]]
     dev = np.maximum(err[pr[:, 0]], err[pr[:, 1]])
     key = np.sort(np.stack([pid[pr[:, 0]], pid[pr[:, 1]]], 1), axis=1)
     uk, inv, cnt = np.unique(key, axis=0, return_inverse=True, return_counts=True)
@@ -103,12 +111,14 @@ def seam_report(pieces: list, border: list, net: ControlNet) -> list:
         a, b = (int(x) for x in uk[g])
         shared = curves[a].keys() & curves[b].keys()
         flipped = bool(np.nanmean(cos[m]) < 0) if np.isfinite(cos[m]).any() else False
+        a_m = 180.0 - ang[m] if flipped else ang[m]
+        ends = at_corner[m]
         out.append({"pieces": [a, b], "patches": [pieces[a].patch, pieces[b].patch],
                     "curves": sorted({curves[a][e] for e in shared} - {-1}),
                     "crease": bool(shared) and all(e in sharp or n_sides[e] > 2 for e in shared),
                     "manifold": all(n_sides[e] == 2 for e in shared), "flipped": flipped,
                     "gap": float(gap[m].max()),
-                    "angle": _nanmax(180.0 - ang[m] if flipped else ang[m]),
+                    "angle": _nanmax(a_m[~ends]), "corner_angle": _nanmax(a_m[ends]),
                     "deviation": float(dev[m].max())})
     return out
 
