@@ -7,7 +7,8 @@ route, export STEP, read it back with OpenCascade and print
 * patches, B-spline faces (pieces) and how many are exact, the most pieces of one
   patch (patches split around a centre), the largest knot grading used;
 * validity (``BRepCheck_Analyzer``), free edges of the read-back shape and whether
-  every one lies on the network's open boundary (curves used by one patch), solids;
+  every one lies on the classical mesh's open boundary or on its curves of three
+  or more patches (a shell per manifold piece), solids;
 * the largest deviation of the B-spline faces from the limit surface (fraction of the
   diagonal; exact limit points one level finer than the fit), the largest seam gap
   (G0) and the largest normal angle across non-crease seams (G1, degrees), along
@@ -37,22 +38,26 @@ from curvenet.errors import CurvenetError  # noqa: E402
 from curvenet.pipeline import surface  # noqa: E402
 
 HEADER = (f"{'input':<28s} {'patches':>7s} {'faces':>5s} {'exact':>5s} {'/patch':>6s} "
-          f"{'grade':>5s} {'valid':>5s} {'free':>5s} {'on open':>7s} {'solid':>5s} "
+          f"{'grade':>5s} {'valid':>5s} {'free':>5s} {'on bdry':>7s} {'solid':>5s} "
           f"{'deviation':>9s} {'gap':>8s} {'G1 deg':>7s} {'corner':>7s} {'export s':>8s}")
 
 
-def _open_curves(res) -> list:
-    """Polylines of the curves used by one patch only."""
-    uses = np.zeros(len(res.network.edges), int)
-    for p in res.patchset.patches:
-        for e in p.edges:
-            uses[e] += 1
-    return [res.network.edges[i].curve for i in np.flatnonzero(uses == 1)]
+def _mesh_borders(mesh):
+    """Points along the classical mesh's edges of one face (open boundary) or of three
+    or more (curves shared by three patches: a shell per manifold piece), and the
+    mesh's mean edge length."""
+    e = np.sort(mesh.edges, axis=1)
+    uniq, count = np.unique(e, axis=0, return_counts=True)
+    border = uniq[count != 2]
+    V = mesh.vertices
+    pts = np.linspace(V[border[:, 0]], V[border[:, 1]], 9).reshape(-1, 3)
+    return pts, float(np.linalg.norm(V[e[:, 0]] - V[e[:, 1]], axis=1).mean())
 
 
-def _free_on_open(shape, curves, diag) -> bool:
-    """Whether every free edge of ``shape`` runs along one of ``curves`` (its points
-    within 1e-3 of the diagonal of their dense samples)."""
+def _free_on_border(shape, mesh) -> bool:
+    """Whether every free edge of ``shape`` runs along the classical mesh's open
+    boundary or non-manifold curves (its points within a quarter of the mean mesh
+    edge length of them)."""
     from OCP.BRepAdaptor import BRepAdaptor_Curve
     from OCP.ShapeAnalysis import ShapeAnalysis_FreeBounds
     from OCP.TopAbs import TopAbs_EDGE
@@ -70,10 +75,10 @@ def _free_on_open(shape, curves, diag) -> bool:
             exp.Next()
     if not pts:
         return True
-    if not curves:
+    border, spacing = _mesh_borders(mesh)
+    if not len(border):
         return False
-    dense = np.concatenate([np.linspace(c[:-1], c[1:], 20).reshape(-1, 3) for c in curves])
-    return bool(cKDTree(dense).query(np.array(pts))[0].max() < 1e-3 * diag)
+    return bool(cKDTree(border).query(np.array(pts))[0].max() < 0.25 * spacing)
 
 
 def run_one(name, source, tmp) -> str:
@@ -92,7 +97,7 @@ def run_one(name, source, tmp) -> str:
     smooth = [s["angle"] for s in seams if not s["crease"]]
     corners = [s["corner_angle"] for s in seams if not s["crease"]]
     gap = max((s["gap"] for s in seams), default=0.0)
-    on_open = _free_on_open(shape, _open_curves(res), pr["diagonal"])
+    on_open = _free_on_border(shape, res.mesh)
     split = max(pr["pieces_per_patch"].values(), default=1)
     return (f"{name:<28s} {len(res.patchset.patches):>7d} {back['faces']:>5d} "
             f"{pr['n_exact']:>5d} {split:>6d} {max(pr['grades_used'], default=0):>5d} "
