@@ -157,6 +157,13 @@ def export_cad(path, result: SurfaceResult, *, schema: str = "AP214",
             f"output {path}: {int(foreign.sum())} faces came from the "
             f"neural fill (a mesh, no B-spline form) and cannot be written as CAD faces; "
             f"save a mesh format or surface with --method classical")
+    holed = sum(bool(p.holes) for p in result.patchset.patches) \
+        if result.patchset is not None else 0
+    if holed and result.diagnostics.get("classical", {}).get("flat_meshed", 0):
+        raise InvalidParameterError(
+            f"output {path}: {holed} faces with holes among flat faces meshed in their "
+            f"plane; their control mesh covers the outer loop only (no trimmed planes in "
+            f"CAD output yet); save a mesh format")
     from curvenet.surfacing.bspline import DEFAULT_LEVEL, extract_bsplines
     bset = extract_bsplines(result.control_net, DEFAULT_LEVEL if level is None else level)
     file_report = cad.write_cad(path, bset, schema=schema, wires=result.wires)
