@@ -4,6 +4,7 @@ Run from the repository root::
 
     python benchmarks/bench_neural.py                 # everything (long on 2 cores)
     python benchmarks/bench_neural.py --only draft100 steps reference vns
+    nice -n 5 python benchmarks/bench_neural.py --only spheres --seeds 0 1 2 3 4
 
 Sections
 --------
@@ -12,6 +13,9 @@ steps      seconds per full-stage step of ``default`` and ``paper`` at 128^3 and
 reference  ``default`` on an 18-stroke rough sphere: time, peak memory, F-score, Chamfer,
            next to the published code's figures on this CPU (128^3, 300 steps: ~22 min,
            13.8 GB, F 99.8 %, Chamfer 2.6e-3)
+spheres    ``--reference-quality`` (default ``default``) on the rough spheres of sketch seeds
+           ``--seeds`` (0-4): F-score at 0.01 and Chamfer against the true sphere, wall and
+           CPU seconds of the fit, peak RSS; ``--set NAME=VALUE`` overrides settings
 vns        time per sketch (``--vns-quality``, default draft) on several vns sketches,
            PNG previews under ``--png-dir`` (default /tmp)
 
@@ -42,6 +46,8 @@ import sys
 import time
 from pathlib import Path
 
+from curvenet.neural.presets import parse_setting
+
 ROOT = Path(__file__).resolve().parents[1]
 DATA = Path(os.environ.get("CURVENET_DATA", ROOT.parent / "shared" / "data"))
 REFERENCE = {"time_s": 22 * 60, "peak_gb": 13.8, "fscore": 0.998, "chamfer": 2.6e-3}
@@ -64,10 +70,11 @@ def _worker(spec: dict) -> dict:
         from curvenet.redraw import rough_sketch
         from curvenet.shapes import latlong_sphere
         shape = latlong_sphere(n_lat=2, n_lon=6)
-        sk = rough_sketch(shape.network, seed=0, split=0.0, overdraw=0.0)
+        sk = rough_sketch(shape.network, seed=spec.get("sketch_seed", 0), split=0.0,
+                          overdraw=0.0)
         strokes, labels = sk.strokes, sk.labels
     out["strokes"] = len(strokes)
-    t = time.perf_counter()
+    t, cpu = time.perf_counter(), time.process_time()
     device = spec.get("device", "cpu")
     r = fit_flow_surface(strokes, labels=labels, quality=spec["quality"], progress=False,
                          device=device, **spec.get("overrides", {}))
@@ -75,6 +82,7 @@ def _worker(spec: dict) -> dict:
     out["timings"] = r.timings
     out["steps"] = r.report["steps"]
     out["faces"] = len(r.faces)
+    out["cpu_s"] = time.process_time() - cpu
     out["peak_gb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e6
     if device.startswith("cuda"):
         out["gpu_peak_gb"] = torch.cuda.max_memory_allocated() / 1e9
@@ -142,6 +150,12 @@ def main(argv=None):
     ap.add_argument("--device", default="cpu", help="cpu or cuda")
     ap.add_argument("--reference-quality", default="default",
                     help="preset of the rough-sphere comparison (default: default)")
+    ap.add_argument("--seeds", type=int, nargs="*", default=[0, 1, 2, 3, 4],
+                    help="rough-sphere sketch seeds of the spheres section")
+    ap.add_argument("--timeout", type=float, default=3600,
+                    help="seconds per rough sphere of the spheres section (loaded machines: more)")
+    ap.add_argument("--set", nargs="*", default=[], metavar="NAME=VALUE",
+                    help="FlowConfig overrides of the spheres section")
     ap.add_argument("--vns-quality", default="draft", help="preset of the vns section")
     ap.add_argument("--png-dir", default="/tmp", help="where the vns previews go")
     ap.add_argument("--worker", help=argparse.SUPPRESS)
@@ -151,6 +165,7 @@ def main(argv=None):
         return
     print(f"# load average at start: {os.getloadavg()}; device {a.device}")
     base = {"threads": a.threads, "device": a.device}
+    overrides = dict(parse_setting(t) for t in a.set)
     png = Path(a.png_dir)
     vns = DATA / "sketches" / "vns"
     if "draft100" in a.only:
@@ -182,6 +197,18 @@ def main(argv=None):
         else:
             _row("reference", f"{label} ({r['strokes']} strokes)", f"{r['time_s']:.1f}s",
                  _memory(r), f"{r['fscore']:.3f}", f"{r['chamfer']:.2e}")
+    if "spheres" in a.only:
+        _row("spheres", "quality", "sketch seed", "F-score@0.01", "Chamfer", "wall", "CPU",
+             "peak RSS")
+        for seed in a.seeds:
+            r = _run({**base, "kind": "sphere", "quality": a.reference_quality,
+                      "sketch_seed": seed, "overrides": overrides}, timeout=a.timeout)
+            if "error" in r:
+                _row("spheres", a.reference_quality, seed, r["error"])
+                continue
+            _row("spheres", a.reference_quality, seed, f"{r['fscore']:.4f}",
+                 f"{r['chamfer']:.2e}", f"{r['time_s']:.1f}s", f"{r['cpu_s']:.1f}s",
+                 _memory(r))
     if "vns" in a.only:
         for name in a.vns:
             path = vns / f"{name}.obj"

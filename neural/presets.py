@@ -26,6 +26,20 @@ and use the linearised data term in between (see :mod:`neural.flow`).
 ``benchmarks/README.md`` has the scores and timings of the presets and of the
 variants tried.
 
+The published code (zytadam/Variational-Neural-Surfacing-of-3D-Sketches) differs
+from the paper's text and from these presets in ways ``paper`` does not copy: its
+data term is the mean of f^2 (not |f|) with f scaled so the box corner is 0.5; its
+FFT solve applies a Gaussian low-pass of about one cell (``smooth_cells`` here, off
+by default); it normalises the splat per node to a unit vector in the first 100 and
+after 600 of its 1000 steps and not in between (here: divided by the sample weight,
+from ``normalize_from`` on); its Eikonal term is one-sided (only ``|g| < sigma`` is
+charged, L1); its smoothness term is scaled by the distance of the surface samples
+to the strokes and leaves out samples on the strokes after step 600; its alignment
+term is ``|cos 4a - 1|`` at stroke samples jittered by 0.002; its SIREN takes the
+unit-cube coordinates as they are (here mapped to [-1, 1], twice the first layer's
+frequency); it puts the sketch's longest side at 0.7 of the box (padding 0.21). It
+draws 10k stroke, 15k surface (marching-cubes mesh) and 15k volume samples per step.
+
 References
 ----------
 Zhang, Wang, Bessmeltsev, "Variational Neural Surfacing of 3D Sketches",
