@@ -55,6 +55,9 @@ Engineering choices (documented deviations / gap fills)
   cylinder is a capsule, and box faces bulge into pillows
   (``benchmarks/bench_flow_limits.py`` measures both; the figures, and the
   terms tried against it, are in ``benchmarks/README.md``).
+* ``polish = k > 0`` re-integrates the final f from k times the stroke and
+  surface samples of one step with the trained network (forward passes only):
+  the same field in expectation, with less Monte-Carlo noise in the splat.
 * Final mesh: pieces of the zero set with no stroke within 4 grid cells are
   dropped (spurious level-set components of the periodic f).
 
@@ -393,8 +396,11 @@ class _FlowFit:
             full = Stage("full", cfg.steps, self._flow_step("full", cfg.steps))
         return [first, full]
 
-    def solve(self, points, values, normalize, need_adjoint):
-        """Splat -> FFT Poisson -> Eq. 11; returns (f_grid, data loss, raw grid)."""
+    def solve(self, points, values, normalize, need_adjoint, n_stroke=None):
+        """Splat -> FFT Poisson -> Eq. 11; returns (f_grid, data loss, raw grid).
+
+        The first ``n_stroke`` (default ``cfg.n_stroke``) points are the stroke samples.
+        """
         from .losses import data_loss
         from .poisson import interpolate, normalize_scale_shift, normalize_splat, splat
         grid, wsum = splat(points, values, self.cfg.res)
@@ -404,9 +410,29 @@ class _FlowFit:
         if normalize:
             grid = normalize_splat(grid, wsum)
         f = self.solver.solve(grid)
-        f_s = interpolate(f, points[: self.cfg.n_stroke])
+        f_s = interpolate(f, points[: n_stroke or self.cfg.n_stroke])
         f, f_s = normalize_scale_shift(f, f_s)
         return f, data_loss(f_s), raw
+
+    def polish(self, f, factor: int):
+        """f re-integrated from ``factor`` times the samples of one step, without gradients.
+
+        The stroke and surface samples of a step are drawn ``factor`` times over (the
+        surface ones on the zero set of ``f``), in the same proportion, and splatted
+        with the normalisation of the last step: the same field in expectation as one
+        step's solve, with the Monte-Carlo noise of the splat down by about
+        ``sqrt(factor)``.
+        """
+        import torch
+        cfg = self.cfg
+        with torch.no_grad():
+            pts, _ = self.sampler.sample(factor * cfg.n_stroke, self.gen)
+            x_u = sample_surface_cells(f, factor * cfg.n_surface, self.gen)
+            if x_u is not None:
+                pts = torch.cat([pts, x_u])
+            vals = torch.cat([self.net(p) for p in pts.split(65536)])
+            normalize = cfg.steps - 1 >= int(cfg.normalize_from * cfg.steps)   # as the last step
+            return self.solve(pts, vals, normalize, False, n_stroke=factor * cfg.n_stroke)[0]
 
     def solve_strokes_only(self, mesh_points=None):
         """f integrated from g at stroke samples (and ``mesh_points``), without gradients."""
@@ -539,6 +565,8 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
 
     t0 = time.perf_counter()
     f_final = run.best if run.best is not None else fit.solve_strokes_only()
+    if cfg.polish > 0 and not interrupted:
+        f_final = fit.polish(f_final, cfg.polish)
     V, F, f_np, origin, h_world, n_cut = _extract(f_final, fit.frame, strokes, labels,
                                                   cut_boundary)
     timings["extract"] = time.perf_counter() - t0

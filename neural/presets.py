@@ -20,9 +20,12 @@ balances quality and time (128^3) and is the better choice on a GPU. Both raise 
 smoothness weight from the paper's 0.01 to 0.1 and start from a radial geometric
 initialisation: with their short budgets the paper's weight leaves mid-frequency
 bumps, and the plain SIREN initialisation starts from a rough field they cannot
-recover from. ``paper`` keeps the published constants (no variant tried was better on
-every test shape). All presets solve the Poisson equation every ``poisson_every`` steps
-and use the linearised data term in between (see :mod:`neural.flow`).
+recover from. ``default`` also re-integrates its final f from 16 times a step's
+samples (``polish``): its few thousand samples per step leave Monte-Carlo noise in
+the surface, where the published code draws 25k. ``paper`` keeps the published
+constants (no variant tried was better on every test shape). All presets solve the
+Poisson equation every ``poisson_every`` steps and use the linearised data term in
+between (see :mod:`neural.flow`).
 ``benchmarks/README.md`` has the scores and timings of the presets and of the
 variants tried.
 
@@ -120,6 +123,12 @@ class FlowConfig:
         itself prefers that surface.
     dtype : str
         ``"float32"`` or ``"float64"``.
+    polish : int
+        After the last step, integrate f once more from this many times the
+        stroke and surface samples of a step (same proportion and normalisation,
+        no gradients); 0 keeps the last step's f. Not in the paper: the
+        published code draws 25k samples per step, a short CPU budget a few
+        thousand, whose splat leaves Monte-Carlo noise in the extracted surface.
     """
 
     res: int = 128
@@ -150,6 +159,7 @@ class FlowConfig:
     geometric_init_steps: int = 100
     splat_volume: bool = False
     dtype: str = "float32"
+    polish: int = 0
 
     def as_dict(self) -> dict:
         """The settings as a plain dict (for reports)."""
@@ -160,7 +170,7 @@ PRESETS: dict[str, FlowConfig] = {
     "draft": FlowConfig(res=64, width=64, hidden_layers=2, n_stroke=1200, n_surface=1000,
                         n_volume=600, init_steps=40, steps=100, lr=3e-4, poisson_every=1,
                         w_smooth=0.1),
-    "default": FlowConfig(w_smooth=0.1),
+    "default": FlowConfig(w_smooth=0.1, polish=16),
     "paper": FlowConfig(res=256, width=256, hidden_layers=4, n_stroke=10000, n_surface=15000,
                         n_volume=15000, init_steps=200, steps=800, lr=5e-5,
                         geometric_init_steps=0),
@@ -211,7 +221,7 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
         if int(v) != v or v < 1:
             raise ValueError(f"{name} must be a positive integer, got {v!r}")
     for name in ("hidden_layers", "init_steps", "steps", "prefit_steps",
-                 "geometric_init_steps"):
+                 "geometric_init_steps", "polish"):
         v = getattr(cfg, name)
         if int(v) != v or v < 0:
             raise ValueError(f"{name} must be a non-negative integer, got {v!r}")

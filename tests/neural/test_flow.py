@@ -95,6 +95,18 @@ def test_refine_prefit_reproduces_the_init_mesh():
     assert f >= 0.9, f
 
 
+def test_polish_keeps_the_surface_of_the_field():
+    # g prefitted to sigma * grad SDF of the unit sphere, no flow step: f re-integrated from
+    # 16 times the samples of a step (strokes and f's zero set) must still be that sphere,
+    # the one the stroke circles lie on
+    import trimesh
+    m = trimesh.creation.icosphere(3, radius=1.0)
+    r = fit_flow_surface(_circles(), progress=False, init_mesh=(m.vertices, m.faces),
+                         quality="draft", res=48, prefit_steps=150, steps=0, polish=16)
+    radius = np.linalg.norm(r.vertices, axis=1)
+    assert abs(radius.mean() - 1.0) < 0.02 and radius.std() < 0.01, (radius.mean(), radius.std())
+
+
 def test_dirichlet_boundary_keeps_walls_outside():
     r = fit_flow_surface(_circles(), progress=False, boundary="dirichlet", **TINY)
     f = r.f_grid
