@@ -421,7 +421,7 @@ class _FlowFit:
         surface ones on the zero set of ``f``), in the same proportion, and splatted
         with the normalisation of the last step: the same field in expectation as one
         step's solve, with the Monte-Carlo noise of the splat down by about
-        ``sqrt(factor)``.
+        ``sqrt(factor)``. The solve low-passes by ``cfg.polish_smooth_cells``.
         """
         import torch
         cfg = self.cfg
@@ -432,6 +432,11 @@ class _FlowFit:
                 pts = torch.cat([pts, x_u])
             vals = torch.cat([self.net(p) for p in pts.split(65536)])
             normalize = cfg.steps - 1 >= int(cfg.normalize_from * cfg.steps)   # as the last step
+            if cfg.polish_smooth_cells != cfg.smooth_cells:
+                from .poisson import PoissonSolver
+                self.solver = PoissonSolver(cfg.res, device=self.dev, dtype=self.dtype,
+                                            smooth_cells=cfg.polish_smooth_cells,
+                                            boundary=cfg.boundary)
             return self.solve(pts, vals, normalize, False, n_stroke=factor * cfg.n_stroke)[0]
 
     def solve_strokes_only(self, mesh_points=None):
