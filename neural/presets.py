@@ -20,10 +20,9 @@ balances quality and time (128^3) and is the better choice on a GPU. Both raise 
 smoothness weight from the paper's 0.01 to 0.1 and start from a radial geometric
 initialisation: with their short budgets the paper's weight leaves mid-frequency
 bumps, and the plain SIREN initialisation starts from a rough field they cannot
-recover from. ``default`` also re-integrates its final f from 16 times a step's
-samples, low-passed by one cell (``polish``, ``polish_smooth_cells``): its few
-thousand samples per step leave Monte-Carlo noise in the surface, where the
-published code draws 25k and low-passes every solve. ``paper`` keeps the published
+recover from. ``polish`` (off in every preset) re-integrates the final f from more
+samples: closer to rough spheres, but off the strokes of a sketch of three boundary
+strokes (``benchmarks/README.md``). ``paper`` keeps the published
 constants (no variant tried was better on every test shape). All presets solve the
 Poisson equation every ``poisson_every`` steps and use the linearised data term in
 between (see :mod:`neural.flow`).
@@ -175,7 +174,7 @@ PRESETS: dict[str, FlowConfig] = {
     "draft": FlowConfig(res=64, width=64, hidden_layers=2, n_stroke=1200, n_surface=1000,
                         n_volume=600, init_steps=40, steps=100, lr=3e-4, poisson_every=1,
                         w_smooth=0.1),
-    "default": FlowConfig(w_smooth=0.1, polish=16, polish_smooth_cells=1.0),
+    "default": FlowConfig(w_smooth=0.1),
     "paper": FlowConfig(res=256, width=256, hidden_layers=4, n_stroke=10000, n_surface=15000,
                         n_volume=15000, init_steps=200, steps=800, lr=5e-5,
                         geometric_init_steps=0),
