@@ -101,13 +101,19 @@ def test_a_curve_without_output_vertices_uses_its_own_points():
     assert np.min(np.linalg.norm(V[:, None] - window[None], axis=2), axis=0).max() < 1e-12
 
 
-def test_a_patch_whose_loops_touch_keeps_its_faces():
+@pytest.mark.parametrize("hole", [
     # a "hole" with a corner on the outline's corner (its own point there, a second vertex
-    # at the same place): Triangle merges the two and loses a segment; nothing changes
+    # at the same place): Triangle merges the two and loses a segment
+    [(0, 0), (0.2, 0.5), (0.5, 0.2)],
+    # a "hole" poking out through the outline: the loops cross and Triangle splits the
+    # segments there
+    [(2.5, 0.5), (3.5, 0.3), (3.5, 0.7)],
+], ids=["loops touch", "loops cross"])
+def test_a_patch_whose_loops_touch_or_cross_keeps_its_faces(hole):
     R, off = _frame(0.4)
     curves, boundary, _, _ = _face(hole=False)
     n = len(curves)
-    curves += _polygon_curves([(0, 0), (0.2, 0.5), (0.5, 0.2)], R, off)
+    curves += _polygon_curves(hole, R, off)
     boundary.append([(n + i, True) for i in range(3)])
     res = surface_loops(curves, boundary[:1])
     flat, normals, offsets = flat_planes(curves, [boundary])
@@ -117,20 +123,3 @@ def test_a_patch_whose_loops_touch_keeps_its_faces():
     assert flat.tolist() == [True] and meshed.tolist() == [False]
     np.testing.assert_array_equal(np.sort(V[F].reshape(-1, 3), axis=0),
                                   np.sort(res.vertices[res.faces].reshape(-1, 3), axis=0))
-
-
-def test_a_patch_whose_loops_cross_keeps_its_faces():
-    # a "hole" poking out through the outline: the loops cross, Triangle splits the
-    # segments there, and the patch keeps the faces it had
-    R, off = _frame(0.4)
-    curves, boundary, _, _ = _face(hole=False)
-    n = len(curves)
-    curves += _polygon_curves([(2.5, 0.5), (3.5, 0.3), (3.5, 0.7)], R, off)
-    boundary.append([(n + i, True) for i in range(3)])
-    res = surface_loops(curves, boundary[:1])
-    flat, normals, offsets = flat_planes(curves, [boundary])
-    fp = np.zeros(len(res.faces), np.int64)
-    V, F, FP, meshed = mesh_flat(res.vertices, res.faces, fp, res.curve_vertices, curves,
-                                 [boundary], flat, normals, offsets)
-    assert flat.tolist() == [True] and meshed.tolist() == [False]
-    assert len(F) == len(res.faces)
