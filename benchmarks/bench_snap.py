@@ -1,9 +1,11 @@
 """Benchmark: snapping rough sketches (target: 1,000 strokes x 100 points in < 2 s).
 
 Run ``python benchmarks/bench_snap.py`` (``--data ../shared/data`` prints one line
-of snapping statistics per public data file instead). Prints one row per case: strokes,
-points, seconds (best of ``--repeat``), and whether the snapped graph matches
-the clean network it was re-drawn from (:func:`curvenet.redraw.match_networks`).
+of snapping statistics per public data file instead; ``--recovery --seeds 200 --gap
+0.04`` the graph-recovery rate per shape on the independent redraws of issue 16).
+Prints one row per case: strokes, points, seconds (best of ``--repeat``), and
+whether the snapped graph matches the clean network it was re-drawn from
+(:func:`curvenet.redraw.match_networks`).
 
 The large case is a saddle grid re-drawn rough with every redraw amplitude and
 the snapping tolerance scaled by ``4 / n`` (so each grid cell looks like the
@@ -188,6 +190,61 @@ def big_table(folder, cap_gb=5):
               f"{load:>5s}  {out}", flush=True)
 
 
+RECOVERY_SHAPES = ("sphere", "ellipsoid", "torus", "capped_cylinder", "box", "l_prism", "house",
+                   "grid_box", "saddle", "two_boxes")
+
+
+def _recovery_trial(job):
+    """Snap one redraw; returns (shape, seed, ok, reason)."""
+    name, seed, gap, generator = job
+    import importlib
+    from tests.curvenet import _redraw2
+    ref = shapes.SHAPES[name]().network
+    draw = (rough_sketch if generator == "rough_sketch" else
+            getattr(importlib.import_module(f"tests.curvenet._{generator}"), generator))
+    net = snap(draw(ref, seed=seed, gap=gap))
+    if _redraw2.graph_recovered(ref, net):
+        return name, seed, True, ""
+    dv = net.number_of_vertices - ref.number_of_vertices
+    de = net.number_of_edges - ref.number_of_edges
+    deg = np.bincount(np.bincount(net.endpoints.ravel(), minlength=net.number_of_vertices))
+    ref_deg = np.bincount(np.bincount(ref.endpoints.ravel(), minlength=ref.number_of_vertices))
+    n = max(len(deg), len(ref_deg))
+    ddeg = np.pad(deg, (0, n - len(deg))) - np.pad(ref_deg, (0, n - len(ref_deg)))
+    diff = ",".join(f"deg{d}{c:+d}" for d, c in enumerate(ddeg) if c)
+    why = f"V{dv:+d} E{de:+d} {diff}" if (dv or de or diff) else "same counts, not matched"
+    return name, seed, False, f"{why}; tol {net.report['snap_tol']:.2%}"
+
+
+def recovery_table(seeds, gap, shape_names=RECOVERY_SHAPES, jobs=1, generator="redraw2"):
+    """Graph-recovery rate per shape on rough redraws (default ``tests/curvenet/_redraw2.py``).
+
+    Each of ``seeds`` seeded redraws per shape (largest split gap ``gap`` of the diagonal)
+    is snapped with the default ``snap_tol="auto"`` and checked with
+    ``graph_recovered``. Prints one row per shape with its failing seeds and why
+    (vertex, edge and per-degree count differences; the tolerance used).
+    """
+    import sys
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+    work = [(name, s, gap, generator) for name in shape_names for s in seeds]
+    if jobs > 1:
+        from multiprocessing import Pool
+        with Pool(jobs) as pool:
+            res = pool.map(_recovery_trial, work, chunksize=4)
+    else:
+        res = [_recovery_trial(w) for w in work]
+    tot = 0
+    for name in shape_names:
+        rows = [r for r in res if r[0] == name]
+        ok = sum(r[2] for r in rows)
+        tot += ok
+        print(f"{name:16s} {ok:4d}/{len(rows)}", flush=True)
+        for _, seed, _, why in (r for r in rows if not r[2]):
+            print(f"    seed {seed}: {why}")
+    print(f"{'all':16s} {tot:4d}/{len(res)} ({tot / len(res):.1%}) at gaps <= {gap:.1%}, "
+          f"generator {generator}")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
@@ -197,7 +254,22 @@ def main(argv=None):
                     "public rough sketch under DIR/sketches instead of timing")
     ap.add_argument("--big", metavar="TMPDIR", help="write the two big inputs of issue 20 "
                     "into TMPDIR and print peak memory and time of snapping each")
+    ap.add_argument("--recovery", action="store_true", help="print the graph-recovery rate "
+                    "per shape on the independent redraws of issue 16 instead of timing")
+    ap.add_argument("--seeds", type=int, default=50, help="--recovery: seeds 0..N-1 per shape")
+    ap.add_argument("--first-seed", type=int, default=0, help="--recovery: first seed")
+    ap.add_argument("--gap", type=float, default=0.015, help="--recovery: largest split gap, "
+                    "fraction of the diagonal")
+    ap.add_argument("--shapes", default=",".join(RECOVERY_SHAPES), help="--recovery: shapes")
+    ap.add_argument("--generator", default="redraw2", help="--recovery: the generator: "
+                    "redraw2 or redraw3 (function NAME in tests/curvenet/_NAME.py), or "
+                    "rough_sketch (curvenet.redraw)")
+    ap.add_argument("--jobs", type=int, default=1, help="--recovery: worker processes")
     args = ap.parse_args(argv)
+    if args.recovery:
+        recovery_table(range(args.first_seed, args.first_seed + args.seeds), args.gap,
+                       args.shapes.split(","), args.jobs, args.generator)
+        return
     if args.big:
         big_table(args.big)
         return
