@@ -12,7 +12,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ._snap_rough import _clean, _smoothstep, _Strokes
-from .core.geometry import interpolate_polyline, resample_polyline
+from .core.geometry import cumulative_length, interpolate_polyline, resample_polyline
 from .core.tolerances import DIVISION_GUARD
 
 __all__ = ["consolidate", "merge_slivers"]
@@ -104,7 +104,11 @@ def consolidate(st, samples, con, tol, h, opts, report):
                 before = [_cut(gp, gc, gh, gc[-1])[::-1][:-1]]
             elif join["head"] == "left" and gh > 0:
                 before = [_cut(gp, gc, 0.0, gh)[:-1]]
-        st.set(host, _clean(np.vstack(before + [hp] + after), 0.05 * tol))
+        poly = _clean(np.vstack(before + [hp] + after), 0.05 * tol)
+        if before or after:  # a guest piece continues the host: maybe past its own start
+            loop = _close_loop(poly, cumulative_length(poly), tol)
+            poly = poly if loop is None else loop
+        st.set(host, poly)
         removed.add(guest)
         report["overdraw_consolidations"] += 1
     if not busy:
@@ -116,6 +120,29 @@ def consolidate(st, samples, con, tol, h, opts, report):
     for p, s, lab in new:
         out.add(p, s, lab)
     return out
+
+
+def _close_loop(poly, cum, tol):
+    """Cut back an end that runs on past the stroke's own start; None if not a loop.
+
+    A polyline longer than ``4 tol`` is a loop when some point of its last ``3 tol``
+    comes within ``tol`` of its start, heading the way the start does (within 60
+    degrees; a stroke doubling back over its start is no loop). It is cut at the
+    closest such point, so a loop that runs past its start (a host extended by a
+    guest piece) leaves at most a gap, as a closed stroke does.
+    """
+    if cum[-1] <= 4.0 * tol:
+        return None
+    tail = np.flatnonzero(cum >= cum[-1] - 3.0 * tol)
+    d = np.linalg.norm(poly[tail] - poly[0], axis=1)
+    q = int(tail[np.argmin(d)])
+    if d.min() > tol:
+        return None
+    head = poly[np.searchsorted(cum, tol)] - poly[0]
+    back = poly[q] - poly[np.searchsorted(cum, cum[q] - tol)]
+    if head @ back <= 0.5 * np.linalg.norm(head) * np.linalg.norm(back):
+        return None
+    return poly[:q + 1]
 
 
 def _cut(poly, cum, a, b):

@@ -13,6 +13,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from ._snap_auto import check_density
+from ._snap_joins import chord_turn, dissolve
 from .core.geometry import arc_length, cumulative_length, interpolate_polyline
 from .core.tolerances import DIVISION_GUARD
 from .network import CurveNetwork
@@ -209,20 +210,34 @@ def _group_pairs(pairs, samples, tol, h, st, opts):
         return dict(empty, overlap=np.zeros(0, bool), a0=np.zeros(0), a1=np.zeros(0),
                     b0=np.zeros(0), b1=np.zeros(0), dist=np.zeros(0))
     brk = np.concatenate([[True], (key[1:] != key[:-1]) | (np.diff(ss[i]) > 2.5 * h)])
+    # a parallel run that touches both ends of `b`, over far more of `b` than of `a`
+    # (a short stroke drawn over the opening of a nearly closed one), is split along `b`
+    lengths = np.array([st.length(k) for k in range(len(st))])
+    cos_od = np.cos(np.radians(opts.overdraw_angle))
+    run = np.cumsum(brk) - 1
+    rs = np.flatnonzero(brk)
+    lo_b, hi_b = np.minimum.reduceat(ss[j], rs), np.maximum.reduceat(ss[j], rs)
+    cosang = np.abs(np.einsum("ij,ij->i", tan[i], tan[j]))
+    par = np.add.reduceat(cosang, rs) / np.diff(np.append(rs, len(i))) >= cos_od
+    both = par & (lo_b <= h) & (hi_b >= lengths[b[rs]] - h) & (
+        hi_b - lo_b > np.maximum.reduceat(ss[i], rs) - np.minimum.reduceat(ss[i], rs) + 4 * tol)
+    if both.any():
+        order = np.lexsort((ss[i], ss[j], run))
+        i, j, a, b, run, cosang = (x[order] for x in (i, j, a, b, run, cosang))
+        brk = np.concatenate([[True], (run[1:] != run[:-1])
+                              | ((np.diff(ss[j]) > 2.5 * h) & both[run[1:]])])
     start = np.flatnonzero(brk)
     comp = np.cumsum(brk) - 1
     a0 = np.minimum.reduceat(ss[i], start)
     a1 = np.maximum.reduceat(ss[i], start)
     b0 = np.minimum.reduceat(ss[j], start)
     b1 = np.maximum.reduceat(ss[j], start)
-    cosang = np.abs(np.einsum("ij,ij->i", tan[i], tan[j]))
     mean_cos = np.add.reduceat(cosang, start) / np.diff(np.append(start, len(i)))
     dist = np.linalg.norm(Q[i] - Q[j], axis=1)
     best = np.lexsort((dist, comp))
     first = np.concatenate([[True], comp[best][1:] != comp[best][:-1]])
     bi = best[first]
     lo = opts.overdraw_length * tol
-    lengths = np.array([st.length(k) for k in range(len(st))])
     sa, sb = a[start], b[start]
     end_a = (a0 <= h) | (a1 >= lengths[sa] - h)
     end_b = (b0 <= h) | (b1 >= lengths[sb] - h)
@@ -232,8 +247,7 @@ def _group_pairs(pairs, samples, tol, h, st, opts):
     # a short stroke drawn (mostly) over a part of another one
     covered = (((a1 - a0) >= 0.8 * lengths[sa]) | ((b1 - b0) >= 0.8 * lengths[sb])) & (
         (a1 - a0) >= 2.0 * tol) & ((b1 - b0) >= 2.0 * tol)
-    overlap = (long_run | end_to_end | covered) & (
-        mean_cos >= np.cos(np.radians(opts.overdraw_angle)))
+    overlap = (long_run | end_to_end | covered) & (mean_cos >= cos_od)
     return {"a": sa, "b": sb, "i": i[bi], "j": j[bi], "a0": a0, "a1": a1,
             "b0": b0, "b1": b1, "overlap": overlap, "dist": dist[bi]}
 
@@ -385,8 +399,9 @@ def _cluster(samples, pos, mk, ms, tol, h):
     ``mk``, ``ms`` (m, 2): the strokes each candidate lies on and its arc parameters
     there. Per-stroke member list: sorted list of (s, junction id). Candidates within
     ``tol`` merge; so do junctions that land within ``1.5 tol`` of each other along
-    one stroke (a corner whose pairwise contacts scattered), for up to four rounds.
-    Junctions are numbered by their first candidate.
+    one stroke (a corner whose pairwise contacts scattered), closest first, for up to
+    four rounds (see :func:`_join_near` for the pairs that do not merge). Junctions
+    are numbered by their first candidate.
     """
     m = len(pos)
     if m == 0:
@@ -394,7 +409,10 @@ def _cluster(samples, pos, mk, ms, tol, h):
     links = (cKDTree(pos).query_pairs(tol, output_type="ndarray") if m > 1
              else np.zeros((0, 2), dtype=np.int64))  # candidates joined
     mc = np.repeat(np.arange(m), 2)  # the candidate of each member
+    L = samples[5].L
+    gap = ((ms <= 0.5 * h) | (ms >= L[mk] - 0.5 * h)).all(axis=1)  # two stroke ends only
     mk, ms = mk.ravel(), ms.ravel()
+    held = {}  # first candidate of a junction -> strokes that end there only by a split
     for _ in range(4):
         cid = components(m, links)
         J = np.zeros((cid.max() + 1, 3))
@@ -405,8 +423,8 @@ def _cluster(samples, pos, mk, ms, tol, h):
         jm = cid[mc]
         order = np.lexsort((ms, mk, jm))
         k_o, s_o, j_o = mk[order], ms[order], jm[order]
-        new = np.concatenate([[True], (k_o[1:] != k_o[:-1]) | (j_o[1:] != j_o[:-1])
-                              | (np.diff(s_o) > 2.0 * tol)])
+        pair = np.concatenate([[True], (k_o[1:] != k_o[:-1]) | (j_o[1:] != j_o[:-1])])
+        new = pair | np.concatenate([[False], np.diff(s_o) > 2.0 * tol])
         first = np.flatnonzero(new)
         last = np.append(first[1:], len(order)) - 1
         qk, qj = k_o[first], j_o[first]
@@ -418,8 +436,13 @@ def _cluster(samples, pos, mk, ms, tol, h):
         near = (qk[1:] == qk[:-1]) & (qj[1:] != qj[:-1]) & (np.diff(qs) < 1.5 * tol)
         if not near.any():
             break
-        joined = np.stack([qj[:-1][near], qj[1:][near]], axis=1)  # junctions: by first member
-        links = np.concatenate([links, first_items(cid)[joined]])
+        g = np.flatnonzero(pair)  # (junction, stroke) pairs, in order, and all gaps there?
+        ends = (j_o[g], k_o[g], np.logical_and.reduceat(gap[mc[order]], g))
+        joined = _join_near((np.diff(qs)[near], qk[1:][near], qj[:-1][near], qj[1:][near]),
+                            cid, gap, ends, held, L, tol)
+        if len(joined) == 0:
+            break
+        links = np.concatenate([links, joined])
     # one stroke, one junction, two equal parameters: keep one
     per_stroke = {}
     for k, s, jn in zip(qk.tolist(), qs.tolist(), qj.tolist()):
@@ -428,6 +451,54 @@ def _cluster(samples, pos, mk, ms, tol, h):
             continue
         out.append((s, jn))
     return J, per_stroke
+
+
+def _join_near(near, cid, gap, ends, held, L, tol):
+    """Candidate pairs ``(p, 2) int64`` that join the junctions of near pairs, closest first.
+
+    ``near``: per pair of junctions ``j1, j2`` within ``1.5 tol`` along stroke ``k``, arrays
+    ``(ds, k, j1, j2)``. ``cid (m,)``: junction of each candidate; ``gap (m,) bool``: the
+    candidate is two stroke ends; ``ends``: per (junction, stroke) pair with members, in
+    order, arrays ``(junction, stroke, only gap members)``. A split stroke (two stroke ends
+    meeting in a gap, nothing else) does not pull in a junction one piece passes through
+    once the gap has joined a junction some stroke passes through: a gap between two
+    nearby crossings would chain them into one. ``held`` (first candidate of a junction ->
+    such pieces) carries over rounds and is updated in place.
+    """
+    ds, kk, j1, j2 = near
+    ej, ek, only = ends
+    key = ej * len(L) + ek
+    split = (np.bincount(ej, minlength=cid.max() + 1) == 2) & (
+        np.bincount(ej, weights=~only, minlength=cid.max() + 1) == 0)
+    through = np.bincount(cid, weights=~gap) > 0  # some stroke passes through
+    fi = first_items(cid)
+    parent, out = {}, []
+
+    def find(j):
+        while parent.get(j, j) != j:
+            j = parent[j]
+        return j
+
+    def gap_only(j, k):
+        return only[np.searchsorted(key, j * len(L) + k)]
+
+    for x in np.lexsort((j2, j1, kk, ds)).tolist():
+        k, a, b = int(kk[x]), int(j1[x]), int(j2[x])
+        ra, rb = find(a), find(b)
+        ha, hb = held.get(fi[ra], set()), held.get(fi[rb], set())
+        if ra == rb or (k in ha and not gap_only(b, k)) or (k in hb and not gap_only(a, k)):
+            continue
+        new = ha | hb
+        for jx, ry in ((a, rb), (b, ra)):  # a split joins a junction some stroke passes through
+            if split[jx] and through[ry]:  # (a stroke under 2 tol is all ends)
+                lo = np.searchsorted(ej, jx)
+                new |= {int(y) for y in ek[lo:lo + 2] if y != k and L[y] > 2.0 * tol}
+        root = min(ra, rb)
+        parent[max(ra, rb)] = root
+        through[root] = through[ra] or through[rb]
+        held[fi[root]] = new
+        out.append((fi[a], fi[b]))
+    return np.array(out, dtype=np.int64).reshape(-1, 2)
 
 
 def first_items(comp):
@@ -468,11 +539,8 @@ def _corners(samples, tol, h, opts):
     s = w + rel * np.repeat((flat.L[ok] - 2 * w) / (n - 1), n)
     pos = rel + np.repeat(start[:-1], n)
     p0, p1, p2 = flat.interp(kk, s - w), flat.interp(kk, s), flat.interp(kk, s + w)
-    u, v = p1 - p0, p2 - p1
-    nu = np.maximum(np.linalg.norm(u, axis=1), DIVISION_GUARD)  # guard 0-length chords
-    nv = np.maximum(np.linalg.norm(v, axis=1), DIVISION_GUARD)
     ang = np.full(start[-1], -1.0)
-    ang[pos] = np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", u, v) / (nu * nv), -1, 1)))
+    ang[pos] = chord_turn(p0, p1, p2)
     peak = (ang >= maximum_filter1d(ang, 2 * pad - 1, mode="nearest")) & (ang > opts.corner_angle)
     out = {}
     inv = -np.ones(start[-1], dtype=np.int64)
@@ -521,54 +589,6 @@ def _displace_and_split(poly, cum, cuts, disp, tol, opts):
         lo, hi = bounds[q], bounds[q + 1]
         pieces.append(p_all[lo:hi + 1] if hi > lo else None)
     return pieces
-
-
-def _tangent_at(curve, at_start, w):
-    """Unit direction leaving the curve's start (or end): towards the first point ``>= w`` away."""
-    c = curve if at_start else curve[::-1]
-    d = np.linalg.norm(c - c[0], axis=1)
-    far = np.flatnonzero(d >= w)
-    vec = c[far[0] if far.size else -1] - c[0]
-    return vec / max(np.linalg.norm(vec), DIVISION_GUARD)  # guard: degenerate curve
-
-
-def _dissolve(edges, corner_ids, tol, opts, nverts):
-    """Join the two edges at each smooth degree-2 vertex that is not a corner.
-
-    ``edges`` is a list of ``(u, v, curve, sources, label)``; vertices are visited
-    in increasing id, each once, with the incidence updated after each join.
-    """
-    count = 0
-    inc = [set() for _ in range(nverts)]
-    for e_id, e in enumerate(edges):
-        inc[e[0]].add(e_id)
-        inc[e[1]].add(e_id)
-    w = opts.corner_window * tol
-    for v in range(nverts):
-        if len(inc[v]) != 2 or v in corner_ids:
-            continue
-        i1, i2 = sorted(inc[v])
-        e1, e2 = edges[i1], edges[i2]
-        if e1[0] == e1[1] or e2[0] == e2[1]:
-            continue
-        c1 = e1[2] if e1[1] == v else e1[2][::-1]  # ends at v
-        u1 = e1[0] if e1[1] == v else e1[1]
-        c2 = e2[2] if e2[0] == v else e2[2][::-1]  # starts at v
-        w2 = e2[1] if e2[0] == v else e2[0]
-        turn = np.degrees(np.arccos(np.clip(-_tangent_at(c1, False, w) @ _tangent_at(c2, True, w),
-                                            -1, 1)))
-        if turn >= opts.corner_angle:
-            continue
-        label = "crease" if "crease" in (e1[4], e2[4]) else "boundary"
-        edges[i1] = (u1, w2, np.vstack([c1, c2[1:]]), tuple(sorted(set(e1[3]) | set(e2[3]))),
-                     label)
-        edges[i2] = None
-        inc[v].clear()
-        inc[w2].discard(i2)
-        inc[w2].add(i1)
-        inc[u1].add(i1)
-        count += 1
-    return [e for e in edges if e is not None], count
 
 
 def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
@@ -668,7 +688,8 @@ def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
             report["t_junctions"] += 1
         elif through[j] == 0 and ends_at[j] >= 2:
             report["gap_merges"] += 1
-    edges, report["dissolved_joins"] = _dissolve(edges, corner_ids, tol, opts, len(verts))
+    edges, report["dissolved_joins"], moved = dissolve(edges, corner_ids, tol, opts, verts)
+    report["corners"] += moved
     edges, report["slivers_merged"] = merge_slivers(edges, tol)
     used = sorted({e[0] for e in edges} | {e[1] for e in edges})
     new_id = {v: i for i, v in enumerate(used)}

@@ -20,12 +20,17 @@ Pipeline of :func:`snap` (``mode="rough"``)
    with tangents within ``overdraw_angle``, is one curve drawn twice. The
    stroke more covered by it (the guest) loses the overlapping stretch; the
    host moves halfway onto the guest there (an average, tapered at both ends),
-   so no sliver cycle remains. Repeated until no overdraw is left.
+   so no sliver cycle remains. Repeated until no overdraw is left. A contact
+   that touches both ends of a nearly closed stroke (a short stroke drawn over
+   its opening) is split where it jumps between them; a host that a guest
+   piece extends past its own start is closed there.
 4. Every other contact is a junction candidate at its closest sample pair:
    the midpoint for a crossing or two ends (gap), the point on the other stroke
    for an end touching a stroke interior (T-junction). A stroke whose two ends
    are within ``tol`` is closed. Candidates within ``tol`` of each other are
-   merged (union-find) into one junction at their mean.
+   merged (union-find) into one junction at their mean, and so are junctions
+   within ``1.5 tol`` along one stroke, closest first; a gap (two stroke ends)
+   that has joined a junction does not pull in a second one.
 5. Corners: where a stroke turns by more than ``corner_angle`` between the
    chords ``tol * corner_window`` before and after a point (local maximum),
    and no junction is within ``tol``, it gets a degree-2 vertex.
@@ -37,8 +42,11 @@ Pipeline of :func:`snap` (``mode="rough"``)
    the last junction is an overshoot and is trimmed; longer ones stay as
    dangling edges (degree-1 vertices, listed in the report).
 7. Degree-2 vertices made only by stroke ends meeting smoothly (gap closing:
-   join angle below ``corner_angle``) are dissolved; parallel edges between the
-   same vertices closer than ``2 tol`` (left-over overdraw) are averaged.
+   join angle below ``corner_angle``) are dissolved, unless the joined curve
+   turns sharply once within ``2 tol`` of the join (a corner the per-stroke
+   search could not see, too close to a stroke end): the vertex moves there.
+   Parallel edges between the same vertices closer than ``2 tol`` (left-over
+   overdraw) are averaged.
 
 ``mode="exact"`` (chosen by ``mode="auto"`` when every stroke end coincides,
 to ``1e-9`` of the diagonal, with a point of another stroke or with its own
