@@ -69,7 +69,7 @@ def _split(curve, s):
     return np.vstack([curve[cum < s], p]), np.vstack([p, curve[cum > s]])
 
 
-def dissolve(edges, corner_ids, tol, opts, verts):
+def dissolve(edges, corner_ids, tol, opts, verts, report):
     """Join the two edges at each smooth degree-2 vertex that is not a corner.
 
     Vertices are visited in increasing id, each once, with the incidence updated
@@ -77,9 +77,8 @@ def dissolve(edges, corner_ids, tol, opts, verts):
     join (:func:`_corner_near_join`), the vertex moves to that corner (``verts``
     is updated in place) instead of being dissolved.
 
-    Returns
-    -------
-    (edges, dissolved, moved) : the new edge list and the two counts.
+    Returns the new edge list; ``report["dissolved_joins"]`` is set and the moved
+    vertices are added to ``report["corners"]``.
     """
     count = moved = 0
     inc = [set() for _ in range(len(verts))]
@@ -121,5 +120,7 @@ def dissolve(edges, corner_ids, tol, opts, verts):
         inc[w2].add(i1)
         inc[u1].add(i1)
         count += 1
-    return [e for e in edges if e is not None], count, moved
+    report["dissolved_joins"] = count
+    report["corners"] += moved
+    return [e for e in edges if e is not None]
 

@@ -688,8 +688,7 @@ def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
             report["t_junctions"] += 1
         elif through[j] == 0 and ends_at[j] >= 2:
             report["gap_merges"] += 1
-    edges, report["dissolved_joins"], moved = dissolve(edges, corner_ids, tol, opts, verts)
-    report["corners"] += moved
+    edges = dissolve(edges, corner_ids, tol, opts, verts, report)
     edges, report["slivers_merged"] = merge_slivers(edges, tol)
     used = sorted({e[0] for e in edges} | {e[1] for e in edges})
     new_id = {v: i for i, v in enumerate(used)}
