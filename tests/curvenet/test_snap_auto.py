@@ -32,9 +32,9 @@ def test_independent_redraw_recovers_graph_ci(name):
 
 @pytest.mark.parametrize("name", SHAPES)
 def test_wide_gaps_recover_graph_ci(name):
-    """4 seeded redraws per shape with gaps up to 4% of the diagonal (auto tolerance):
+    """3 seeded redraws per shape with gaps up to 4% of the diagonal (auto tolerance):
     at most one miss (the 200-seed rates are in benchmarks/README.md)."""
-    assert _rate(name, range(100, 104), 0.04) >= 3 / 4
+    assert _rate(name, range(100, 103), 0.04) >= 2 / 3
 
 
 def test_third_noise_model_recovers_graph_ci():
