@@ -465,8 +465,7 @@ def _join_near(near, cid, gap, ends, held, L, tol):
     nearby crossings would chain them into one. ``held`` (first candidate of a junction ->
     such pieces) carries over rounds and is updated in place.
     """
-    ds, kk, j1, j2 = near
-    ej, ek, only = ends
+    (ds, kk, j1, j2), (ej, ek, only) = near, ends
     key = ej * len(L) + ek
     split = (np.bincount(ej, minlength=cid.max() + 1) == 2) & (
         np.bincount(ej, weights=~only, minlength=cid.max() + 1) == 0)

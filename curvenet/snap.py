@@ -28,9 +28,9 @@ Pipeline of :func:`snap` (``mode="rough"``)
    the midpoint for a crossing or two ends (gap), the point on the other stroke
    for an end touching a stroke interior (T-junction). A stroke whose two ends
    are within ``tol`` is closed. Candidates within ``tol`` of each other are
-   merged (union-find) into one junction at their mean, and so are junctions
-   within ``1.5 tol`` along one stroke, closest first; a gap (two stroke ends)
-   that has joined a junction does not pull in a second one.
+   merged (connected components) into one junction at their mean, and so are
+   junctions within ``1.5 tol`` along one stroke, closest first; a gap (two
+   stroke ends) that has joined a junction does not pull in a second one.
 5. Corners: where a stroke turns by more than ``corner_angle`` between the
    chords ``tol * corner_window`` before and after a point (local maximum),
    and no junction is within ``tol``, it gets a degree-2 vertex.
