@@ -26,7 +26,7 @@ from .errors import InvalidParameterError, SketchFormatError
 
 __all__ = ["evaluate_mesh", "stroke_distance", "stroke_fidelity", "sketch_fidelity",
            "format_report",
-           "load_mesh_arrays", "sample_surface", "point_surface_distance"]
+           "load_mesh_arrays", "sample_surface", "point_surface_distance", "stroke_samples"]
 
 #: Stroke polylines are resampled with this spacing relative to the sketch's bbox diagonal.
 STROKE_SPACING_REL = 1e-3
@@ -370,12 +370,13 @@ def stroke_distance(mesh, strokes, *, spacing: float = STROKE_SPACING_REL) -> di
     }
 
 
-def _stroke_sample_distances(mesh, strokes, spacing):
-    """Distances from arc-length stroke samples to the mesh (input units).
+def stroke_samples(strokes, spacing):
+    """Arc-length samples of the strokes, ``spacing`` of the sketch's diagonal apart.
 
-    Returns ``(d, diag, vertices, samples)``: ``d`` (k,) float64 per sample, ``diag`` the
-    sketch's bounding-box diagonal (samples are ``spacing * diag`` apart), ``vertices``
-    (V, 3) float64 of the mesh, ``samples`` (k, 3) float64 the stroke samples.
+    Returns ``(lines, diag, samples, counts)``: ``lines`` the strokes as (n, 3) float64
+    arrays, ``diag`` the sketch's bounding-box diagonal, ``samples`` (k, 3) float64 the
+    samples of every stroke in stroke order, ``counts`` (len(lines),) int64 the samples
+    per stroke.
     """
     if not (isinstance(spacing, (int, float, np.floating)) and math.isfinite(spacing)
             and spacing > 0):
@@ -383,14 +384,26 @@ def _stroke_sample_distances(mesh, strokes, spacing):
     lines = [as_polyline(s, name=f"strokes[{i}]") for i, s in enumerate(_stroke_list(strokes))]
     if not lines:
         raise InvalidParameterError("strokes: no strokes to measure")
-    v, f = load_mesh_arrays(mesh, name="mesh")
     diag = float(np.linalg.norm(np.ptp(np.concatenate(lines), axis=0)))
     if not diag > 0:
         raise InvalidParameterError("strokes: the sketch has zero extent")
+    dense = [densify_polyline(pl, spacing * diag) for pl in lines]
+    return lines, diag, np.concatenate(dense), np.array([len(p) for p in dense], np.int64)
+
+
+def _stroke_sample_distances(mesh, strokes, spacing):
+    """Distances from arc-length stroke samples to the mesh (input units).
+
+    Returns ``(d, diag, vertices, samples)``: ``d`` (k,) float64 per sample, ``diag`` the
+    sketch's bounding-box diagonal (samples are ``spacing * diag`` apart), ``vertices``
+    (V, 3) float64 of the mesh, ``samples`` (k, 3) float64 the stroke samples
+    (:func:`stroke_samples`).
+    """
+    _lines, diag, pts, _counts = stroke_samples(strokes, spacing)
+    v, f = load_mesh_arrays(mesh, name="mesh")
     f, _n, _a = _drop_degenerate(v, f)
     if len(f) == 0:
         raise InvalidParameterError("mesh: all triangles have zero area")
-    pts = np.concatenate([densify_polyline(pl, spacing * diag) for pl in lines])
     d, _ = point_surface_distance(pts, v, f)
     return d, diag, v, pts
 

@@ -22,7 +22,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from .core.geometry import arc_length, cumulative_length, densify_polyline, interpolate_polyline
-from .evaluate import FIDELITY_TOL_REL, STROKE_SPACING_REL, _stroke_list, point_surface_distance
+from .evaluate import FIDELITY_TOL_REL, STROKE_SPACING_REL, point_surface_distance, stroke_samples
 
 __all__ = ["REGION_GAP", "plan_regions", "region_strokes", "trim_fill", "assemble",
            "stroke_wires"]
@@ -214,20 +214,17 @@ def stroke_wires(strokes, vertices, faces, *, tol_rel: float = FIDELITY_TOL_REL,
     >>> [w.round(3).tolist() for w in stroke_wires([stroke], box.vertices, box.faces)]
     [[[0.518, -0.5, 0.5], [1.5, -0.5, 0.5]]]
     """
-    lines = [np.asarray(s, np.float64) for s in _stroke_list(strokes)]
-    diag = _diagonal(lines)
-    dense = [densify_polyline(p, spacing_rel * diag) for p in lines]
-    pts = np.concatenate(dense)
+    lines, diag, pts, counts = stroke_samples(strokes, spacing_rel)
     off = point_surface_distance(pts, vertices, faces)[0] >= tol_rel * diag
-    sid = np.repeat(np.arange(len(dense)), [len(p) for p in dense])
-    first = np.r_[0, np.cumsum([len(p) for p in dense])[:-1]]
+    sid = np.repeat(np.arange(len(lines)), counts)
+    first = np.r_[0, np.cumsum(counts)[:-1]]
     step = np.r_[0.0, np.linalg.norm(np.diff(pts, axis=0), axis=1)]
     step[first] = 0.0
     cum = np.cumsum(step) - np.cumsum(step)[first][sid]   # arc length along each stroke
     same = sid[1:] == sid[:-1]
     starts = np.flatnonzero(off & ~np.r_[False, off[:-1] & same])
     ends = np.flatnonzero(off & ~np.r_[off[1:] & same, False])
-    last = first + [len(p) - 1 for p in dense]
+    last = first + counts - 1
     lo = np.maximum(starts - 1, first[sid[starts]])
     hi = np.minimum(ends + 1, last[sid[ends]])
     wires = []
