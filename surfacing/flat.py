@@ -28,7 +28,11 @@ FLAT_TOL = 1e-6
 
 
 def loop_points(curves, loop):
-    """Points of a closed loop of ``(curve index, forward)``, each junction once: (m, 3)."""
+    """Points of a closed loop of ``(curve index, forward)``, each junction once: (m, 3).
+
+    Any per-curve arrays walk the same way: output vertex ids along each curve give
+    the ids around the loop, (m,).
+    """
     return np.concatenate([(curves[c] if f else curves[c][::-1])[:-1] for c, f in loop])
 
 
@@ -121,12 +125,6 @@ def _with_own_points(V, chains, curves, boundaries, patches):
     return np.concatenate([V, *add]), chains
 
 
-def _rings(boundary, chains):
-    """Vertex ids around each loop, each junction once."""
-    return [np.concatenate([(chains[c] if f else chains[c][::-1])[:-1] for c, f in lp])
-            for lp in boundary]
-
-
 #: Boundary vertices closer than this (fraction of the patch's extent) make the CDT refuse.
 _MERGED = 1e-9
 
@@ -212,7 +210,8 @@ def mesh_flat(vertices, faces, face_patch, chains, curves, boundaries, flat, nor
     todo = np.flatnonzero(flat)
     V, chains = _with_own_points(np.asarray(vertices, dtype=np.float64), chains, curves,
                                  boundaries, todo)
-    frames = [_plane_frame(V, _rings(boundaries[k], chains), normals[k]) for k in todo]
+    frames = [_plane_frame(V, [loop_points(chains, lp) for lp in boundaries[k]], normals[k])
+              for k in todo]
     budget = None if max_faces is None else max_faces - int((~flat[FP]).sum())
     cdts = _cdts(frames, _spacings(frames, edge_length, budget), budget)
     meshed = np.zeros(len(boundaries), bool)
