@@ -60,18 +60,56 @@ JUNCTION_TOL = 1e-6
 #: Adaptive pieces: a curve gets one more piece of ``N`` segments per this many times the
 #: median curve length ...
 PIECE_LENGTH = 2.0
-#: ... and per this much total turning (degrees).
+#: ... and per this much turning (degrees) seen at the scale of the pieces ...
 PIECE_TURN = 120.0
+#: ... a scale of ``s`` pieces being the curve resampled at ``TURN_SEGMENTS * s``
+#: segments (twice the default resolution per piece), for ``s`` up to :data:`TURN_SCALES`
+#: (32 segments). A curve needs more than ``s`` pieces when it turns by more than
+#: ``PIECE_TURN * s`` at that scale. Seen only at 32 segments, the wobble of a hand-drawn
+#: 90 degree arc summed to 125 degrees (under 95 at 8), and one quad strip of a regular
+#: layout got twice the control points of its neighbours, which the fair fit turns into
+#: a bulge; seen only at 8, detail finer than a piece would be aliased away.
+TURN_SEGMENTS = 8
+TURN_SCALES = 4
 #: Ratios within this of an integer count as that integer (equal curves get equal pieces).
 PIECE_ROUNDING = 1e-9
+
+
+def _turning(curve: np.ndarray, n: int) -> float:
+    """Total turning (degrees) of ``curve`` resampled at ``n`` equal-arc segments.
+
+    Scaled by ``n / (n - 1)``: the ``n - 1`` joints of a circular arc's resample turn by
+    ``(n - 1) / n`` of its angle, so an arc measures its angle at any ``n``.
+    """
+    d = np.diff(resample_polyline(curve, n), axis=0)
+    d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), DIVISION_GUARD)
+    return float(np.degrees(np.arccos(np.clip((d[1:] * d[:-1]).sum(1), -1, 1))).sum()
+                 * n / (n - 1))
+
+
+def _turn_pieces(curve: np.ndarray) -> int:
+    """Pieces a curve's turning asks for: the most any scale ``s`` (1 .. TURN_SCALES) asks.
+
+    At scale ``s`` the curve is resampled at ``TURN_SEGMENTS * s`` segments; when it turns
+    by more than ``PIECE_TURN * s`` there, ``s`` pieces cannot follow it and the scale asks
+    for ``ceil(turning / PIECE_TURN)``; otherwise it asks for nothing (coarser scales
+    decide whether fewer are enough). Stroke wobble below a piece's scale therefore adds
+    nothing to a curve that the coarse scales find smooth.
+    """
+    need = 1
+    for s in range(1, TURN_SCALES + 1):
+        t = _turning(curve, TURN_SEGMENTS * s) / PIECE_TURN
+        if t > s * (1 + PIECE_ROUNDING):
+            need = max(need, int(np.ceil(t - PIECE_ROUNDING)))
+    return need
 
 
 def curve_pieces(curves: list, closed: np.ndarray) -> np.ndarray:
     """Pieces (of ``N`` control segments each) per curve for adaptive resolution.
 
-    ``max(1, ceil(length / (PIECE_LENGTH * median length)), ceil(turning / PIECE_TURN))``,
-    at least 2 for a closed curve. Turning is summed over the curve resampled at 32
-    segments (robust to sample noise).
+    ``max(1, ceil(length / (PIECE_LENGTH * median length)), turning pieces)``, at least 2
+    for a closed curve; the turning pieces are what the curve's turning asks for at the
+    scales of one to :data:`TURN_SCALES` pieces (:func:`_turn_pieces`).
 
     Returns
     -------
@@ -79,14 +117,10 @@ def curve_pieces(curves: list, closed: np.ndarray) -> np.ndarray:
     """
     lengths = np.array([np.linalg.norm(np.diff(c, axis=0), axis=1).sum() for c in curves])
     med = float(np.median(lengths)) if len(lengths) else 1.0
-    turn = np.empty(len(curves))
-    for i, c in enumerate(curves):
-        d = np.diff(resample_polyline(c, 32), axis=0)
-        d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), DIVISION_GUARD)
-        turn[i] = np.degrees(np.arccos(np.clip((d[1:] * d[:-1]).sum(1), -1, 1))).sum()
+    turn = np.array([_turn_pieces(np.asarray(c, dtype=np.float64)) for c in curves])
     # a curve exactly PIECE_LENGTH medians long (rounding noise aside) stays one piece
     m = np.maximum(np.ceil(lengths / (PIECE_LENGTH * max(med, DIVISION_GUARD)) - PIECE_ROUNDING),
-                   np.ceil(turn / PIECE_TURN - PIECE_ROUNDING))
+                   turn)
     m = np.maximum(m, 1).astype(np.int64)
     return np.where(closed, np.maximum(m, 2), m)
 

@@ -136,6 +136,31 @@ def test_adaptive_pieces_follow_quad_strips():
     assert cm.patch_kind == ["grid"]
 
 
+def test_stroke_wobble_does_not_count_as_winding():
+    # a quarter circle turns 90 degrees; a hand-drawn one wobbles (here a smooth offset
+    # of 1% of its length, three periods: the scale of the re-drawn torus's strokes),
+    # which adds up when summed over fine segments (136 degrees at 32). It stays one
+    # piece, like the clean arc; a half circle (180 degrees) gets two either way.
+    from curvenet.surfacing.controlmesh import curve_pieces
+    t = np.linspace(0, 1, 200)
+
+    def arc(turn, wobble):
+        r = 1 + wobble * turn * np.sin(6 * np.pi * t)
+        return np.c_[np.cos(t * turn), np.sin(t * turn), 0 * t] * r[:, None]
+
+    arcs = [arc(np.pi / 2, 0), arc(np.pi / 2, 0.01), arc(np.pi, 0), arc(np.pi, 0.01)]
+    np.testing.assert_array_equal(curve_pieces(arcs, np.zeros(4, bool)), [1, 1, 2, 2])
+    # detail finer than one piece still counts: a straight curve with 12 waves turns by
+    # ~1500 degrees (8 segments alias it to a few hundred); it gets the pieces that bring
+    # its turning at their own scale under 120 degrees per piece
+    wavy = np.c_[t, 0.05 * np.sin(24 * np.pi * t), 0 * t]
+    m = curve_pieces([wavy] * 4, np.zeros(4, bool))[0]
+    fine = np.diff(wavy, axis=0)
+    fine /= np.linalg.norm(fine, axis=1, keepdims=True)
+    total = np.degrees(np.arccos(np.clip((fine[1:] * fine[:-1]).sum(1), -1, 1))).sum()
+    assert total / 120 * 0.5 < m <= np.ceil(total / 120), (m, total)
+
+
 @pytest.mark.parametrize("bad", [0, 1, -2, 2.5])
 def test_resolution_validated(bad):
     s, curves = _net("box")
