@@ -60,6 +60,12 @@ Engineering choices (documented deviations / gap fills)
   the same field in expectation, with less Monte-Carlo noise in the splat.
 * Final mesh: pieces of the zero set with no stroke within 4 grid cells are
   dropped (spurious level-set components of the periodic f).
+* ``anchors`` (not in the paper): oriented points of another surface the fit must
+  meet (a hybrid fill beside classical patches). Each step draws
+  ``min(m, n_stroke)`` of them; they join the stroke samples in the data term
+  (f = 0 there), the splat and the Eikonal term, and their normals are a target of
+  g through the orientation-free :func:`neural.losses.normal_loss` (weight
+  ``w_normal``). The padded box covers them too.
 
 References
 ----------
@@ -85,7 +91,7 @@ from .training import Stage, Step, seeded, torch_device, train
 __all__ = ["FlowResult", "fit_flow_surface", "StrokeSampler", "sample_surface_cells",
            "sample_surface_marching_cubes", "Frame"]
 
-_TERMS = ("total", "align", "smooth", "data", "eik", "curl")
+_TERMS = ("total", "align", "smooth", "data", "eik", "curl", "normal")
 
 
 @dataclass
@@ -134,7 +140,7 @@ class FlowResult(MeshResult):
     timings : dict, seconds per stage (``prefit``, ``init``, ``full``,
         ``extract``, ``total``)
     history : dict, stage -> term -> list of per-step values
-        (terms ``total, align, smooth, data, eik, curl``; unweighted)
+        (terms ``total, align, smooth, data, eik, curl, normal``; unweighted)
     """
 
     f_grid: np.ndarray
@@ -278,8 +284,8 @@ def _check_strokes(strokes, labels):
 
 
 def fit_flow_surface(strokes, *, labels=None, quality: str = "draft", device="cpu", seed: int = 0,
-                     init_mesh=None, progress: bool = True, cut_boundary: bool = True,
-                     **overrides) -> FlowResult:
+                     init_mesh=None, anchors=None, progress: bool = True,
+                     cut_boundary: bool = True, **overrides) -> FlowResult:
     """Fit a flow-aligned implicit surface to 3D strokes (Zhang et al. 2025).
 
     Parameters
@@ -303,6 +309,10 @@ def fit_flow_surface(strokes, *, labels=None, quality: str = "draft", device="cp
         target is already a gradient, and a curl penalty on the random initial
         SIREN drives g to a constant), then the full stage runs (no
         initialisation stage).
+    anchors : (points (m, 3), normals (m, 3)) float64, optional
+        Oriented points, world coordinates, that the surface should pass through with
+        its normal along ``normals`` (either sign; normalised here), e.g. samples of
+        classical patches a fill must meet (see the module notes).
     progress : bool
         Show a tqdm bar with the loss terms.
     cut_boundary : bool
@@ -332,7 +342,25 @@ def fit_flow_surface(strokes, *, labels=None, quality: str = "draft", device="cp
     cfg = get_config(quality, **overrides)
     strokes, labels = _check_strokes(strokes, labels)
     dev = torch_device(device)
-    return _fit(strokes, labels, cfg, dev, int(seed), init_mesh, progress, cut_boundary, quality)
+    return _fit(strokes, labels, cfg, dev, int(seed), init_mesh, progress, cut_boundary, quality,
+                anchors=_check_anchors(anchors))
+
+
+def _check_anchors(anchors):
+    """``(points (m, 3), unit normals (m, 3))`` as float64 arrays, or None."""
+    if anchors is None:
+        return None
+    try:
+        pts, nrm = (np.asarray(a, dtype=np.float64) for a in anchors)
+    except (TypeError, ValueError):
+        raise ValueError("anchors must be a pair (points (m, 3), normals (m, 3))") from None
+    if pts.ndim != 2 or pts.shape[1] != 3 or nrm.shape != pts.shape or not len(pts):
+        raise ValueError(f"anchors must be (points (m, 3), normals (m, 3)) with m >= 1, got "
+                         f"shapes {pts.shape} and {nrm.shape}")
+    length = np.linalg.norm(nrm, axis=1, keepdims=True)
+    if not (np.isfinite(pts).all() and np.isfinite(nrm).all() and (length > NORM_EPS).all()):
+        raise ValueError("anchors must be finite, with non-zero normals")
+    return pts, nrm / length
 
 
 class _FlowFit:
@@ -341,7 +369,7 @@ class _FlowFit:
     Its step functions (:meth:`stages`) are run by :func:`neural.training.train`.
     """
 
-    def __init__(self, strokes, cfg: FlowConfig, dev, seed: int, init_mesh):
+    def __init__(self, strokes, cfg: FlowConfig, dev, seed: int, init_mesh, anchors=None):
         import torch
 
         from .poisson import PoissonSolver
@@ -349,7 +377,8 @@ class _FlowFit:
 
         self.cfg, self.dev = cfg, dev
         self.dtype = torch.float64 if cfg.dtype == "float64" else torch.float32
-        self.frame = Frame.from_points(np.vstack(strokes), cfg.padding)
+        self.frame = Frame.from_points(np.vstack(strokes + ([] if anchors is None
+                                                            else [anchors[0]])), cfg.padding)
         strokes_unit = [self.frame.to_unit(s) for s in strokes]
         self.gen, self.rng = seeded(seed, dev)
         self.net = GradientSiren(cfg.width, cfg.hidden_layers, cfg.omega_0).to(
@@ -360,6 +389,9 @@ class _FlowFit:
         self.f = None                  # the last solved f (unit-cube grid)
         self.lam = None                # d(data loss) / d(splat), for poisson_every > 1
         self.data = float("nan")       # the last solved data loss
+        self.anchors = None if anchors is None else tuple(
+            torch.as_tensor(a, device=dev, dtype=self.dtype)
+            for a in (self.frame.to_unit(anchors[0]), anchors[1]))
         self.prefit = None
         if init_mesh is not None:
             P, target, mesh_surf = _prefit_targets(init_mesh, self.frame, cfg.sigma, self.rng)
@@ -399,7 +431,8 @@ class _FlowFit:
     def solve(self, points, values, normalize, need_adjoint, n_stroke=None):
         """Splat -> FFT Poisson -> Eq. 11; returns (f_grid, data loss, raw grid).
 
-        The first ``n_stroke`` (default ``cfg.n_stroke``) points are the stroke samples.
+        The first ``n_stroke`` (default ``cfg.n_stroke``) points are the data samples
+        (the stroke samples, then the anchors').
         """
         from .losses import data_loss
         from .poisson import interpolate, normalize_scale_shift, normalize_splat, splat
@@ -426,7 +459,8 @@ class _FlowFit:
         import torch
         cfg = self.cfg
         with torch.no_grad():
-            pts, _ = self.sampler.sample(factor * cfg.n_stroke, self.gen)
+            pts = self._data_points(factor)
+            n_data = len(pts)
             x_u = sample_surface_cells(f, factor * cfg.n_surface, self.gen)
             if x_u is not None:
                 pts = torch.cat([pts, x_u])
@@ -437,16 +471,45 @@ class _FlowFit:
                 self.solver = PoissonSolver(cfg.res, device=self.dev, dtype=self.dtype,
                                             smooth_cells=cfg.polish_smooth_cells,
                                             boundary=cfg.boundary)
-            return self.solve(pts, vals, normalize, False, n_stroke=factor * cfg.n_stroke)[0]
+            return self.solve(pts, vals, normalize, False, n_stroke=n_data)[0]
 
     def solve_strokes_only(self, mesh_points=None):
         """f integrated from g at stroke samples (and ``mesh_points``), without gradients."""
         import torch
         with torch.no_grad():
-            pts, _ = self.sampler.sample(self.cfg.n_stroke, self.gen)
+            pts = self._data_points(1)
+            n_data = len(pts)
             if mesh_points is not None:
                 pts = torch.cat([pts, mesh_points])
-            return self.solve(pts, self.net(pts), False, False)[0]
+            return self.solve(pts, self.net(pts), False, False, n_stroke=n_data)[0]
+
+    def _anchor_sample(self, factor: int = 1):
+        """``factor * min(m, n_stroke)`` anchors drawn with replacement: (points, normals)."""
+        import torch
+        pts, nrm = self.anchors
+        idx = torch.randint(len(pts), (factor * min(len(pts), self.cfg.n_stroke),),
+                            generator=self.gen, device=self.dev)
+        return pts[idx], nrm[idx]
+
+    def _data_points(self, factor: int):
+        """``factor`` times a step's stroke samples, then as many times its anchors."""
+        import torch
+        pts, _ = self.sampler.sample(factor * self.cfg.n_stroke, self.gen)
+        if self.anchors is None:
+            return pts
+        return torch.cat([pts, self._anchor_sample(factor)[0]])
+
+    def _anchor_terms(self, vals, x_s, g_s):
+        """Anchor samples after the stroke samples (data, splat, Eikonal); their normal term."""
+        import torch
+
+        from .losses import normal_loss
+        if self.anchors is None:
+            return x_s, g_s
+        x_a, n_a = self._anchor_sample()
+        g_a = self.net(x_a)
+        vals["normal"] = normal_loss(g_a, n_a)
+        return torch.cat([x_s, x_a]), torch.cat([g_s, g_a])
 
     def _bootstrap(self):
         """f from the prefitted g on strokes + init-mesh samples (start of the full stage)."""
@@ -489,20 +552,23 @@ class _FlowFit:
             g_s, G_s = g_sv[: cfg.n_stroke], G_sv[: cfg.n_stroke]
             x_u = self._surface_samples(cfg.n_surface) if full else None
             vals = {"align": alignment_loss(g_s, G_s, t_s), "curl": curl_loss(G_sv[cfg.n_stroke:])}
+            x_s, g_s = self._anchor_terms(vals, x_s, g_s)
             pts, gv = self._surface_terms(vals, x_u, x_s, g_s)
             if cfg.splat_volume:
                 pts, gv = torch.cat([pts, x_v]), torch.cat([gv, g_sv[cfg.n_stroke:]])
             normalize = full and k >= int(cfg.normalize_from * n_steps)
             do_solve = (k % cfg.poisson_every == 0) or k == n_steps - 1 or self.lam is None
             if do_solve:
-                f, vals["data"], raw = self.solve(pts, gv, normalize, cfg.poisson_every > 1)
+                f, vals["data"], raw = self.solve(pts, gv, normalize, cfg.poisson_every > 1,
+                                                  n_stroke=len(x_s))
                 data_term = cfg.w_data * vals["data"]
             else:
                 data_term = (self.lam * splat(pts, gv, cfg.res)[0]).sum()
             loss = (cfg.w_align * vals["align"] + cfg.w_curl * vals["curl"]
                     + cfg.w_eik * vals["eik"] + data_term)
-            if "smooth" in vals:
-                loss = loss + cfg.w_smooth * vals["smooth"]
+            for term, w in (("smooth", cfg.w_smooth), ("normal", cfg.w_normal)):
+                if term in vals:
+                    loss = loss + w * vals[term]
             vals["total"] = loss
             row = self._row(vals)
             if do_solve:
@@ -555,9 +621,10 @@ class _FlowFit:
             raise FloatingPointError(f"non-finite loss at {stage} step {k}: {row}")
 
 
-def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_boundary, quality):
+def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_boundary, quality,
+         anchors=None):
     t_start = time.perf_counter()
-    fit = _FlowFit(strokes, cfg, dev, seed, init_mesh)
+    fit = _FlowFit(strokes, cfg, dev, seed, init_mesh, anchors)
     stages = fit.stages()
     interrupted = False
     if init_mesh is None and cfg.geometric_init_steps > 0:

@@ -5,6 +5,9 @@ set (Sec. 5.1): alignment and data on stroke samples, smoothness and Eikonal on
 iso-surface samples, curl on volume samples. The terms are unweighted; their
 weights (paper: 1, 0.01, 30, 7, 7) are the ``w_*`` fields of
 :class:`neural.presets.FlowConfig`, applied by :mod:`neural.flow`.
+:func:`normal_loss` is not in the paper: it aligns g with the normals of oriented
+anchor points (samples of another surface the fit must meet), which also enter the
+data term as stroke samples do.
 
 References
 ----------
@@ -21,7 +24,7 @@ from curvenet.core.tolerances import NORM_EPS
 from .geometry import alignment_cos4, covariant_tv, curl, second_fundamental_form, tangent_frame
 
 __all__ = ["alignment_loss", "smoothness_loss", "smoothness_loss_autograd", "data_loss",
-           "eikonal_loss", "curl_loss"]
+           "eikonal_loss", "curl_loss", "normal_loss"]
 
 
 def alignment_loss(g, G, tangents):
@@ -86,3 +89,22 @@ def curl_loss(G):
     """Eq. 12: mean of ``|curl g|^2`` over volume samples."""
     c = curl(G)
     return (c * c).sum(-1).mean()
+
+
+def normal_loss(g, normals, *, eps: float = NORM_EPS):
+    """Mean of ``1 - cos^2`` between g and the unit normals of anchor points.
+
+    Orientation-free: g parallel or antiparallel to the normal costs 0, g in the
+    tangent plane costs 1, so the anchors' normals need no consistent orientation
+    (the sign of g is the fit's own choice, see :mod:`neural.flow`).
+
+    Parameters
+    ----------
+    g : (N, 3), normals : (N, 3) unit vectors
+
+    Returns
+    -------
+    scalar tensor in ``[0, 1]``; a sample with ``|g| = 0`` costs 1.
+    """
+    cos = (g * normals).sum(-1) / g.norm(dim=-1).clamp(min=eps)
+    return (1.0 - cos * cos).mean()

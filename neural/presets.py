@@ -93,6 +93,9 @@ class FlowConfig:
         Adam learning rate. grad_clip : float, gradient-norm clip (0 = off).
     w_align, w_smooth, w_data, w_eik, w_curl : float
         Loss weights of Eq. 13 (paper: 1, 0.01, 30, 7, 7).
+    w_normal : float
+        Weight of the anchors' normal term (:func:`neural.losses.normal_loss`; only
+        with ``anchors``, not in the paper).
     sigma : float
         Eikonal target gradient norm (paper: 0.5, Sec. 4.3).
     poisson_every : int
@@ -152,6 +155,7 @@ class FlowConfig:
     w_data: float = 30.0
     w_eik: float = 7.0
     w_curl: float = 7.0
+    w_normal: float = 7.0
     sigma: float = 0.5
     poisson_every: int = 1
     normalize_from: float = 0.6
@@ -238,8 +242,8 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
     for name in ("padding", "lr", "sigma", "omega_0"):
         if not getattr(cfg, name) > 0:
             raise ValueError(f"{name} must be positive, got {getattr(cfg, name)!r}")
-    for name in ("w_align", "w_smooth", "w_data", "w_eik", "w_curl", "grad_clip", "smooth_cells",
-                 "polish_smooth_cells"):
+    for name in ("w_align", "w_smooth", "w_data", "w_eik", "w_curl", "w_normal", "grad_clip",
+                 "smooth_cells", "polish_smooth_cells"):
         if not getattr(cfg, name) >= 0:
             raise ValueError(f"{name} must be non-negative, got {getattr(cfg, name)!r}")
     if not 0.0 <= cfg.normalize_from <= 1.0:
