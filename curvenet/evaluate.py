@@ -123,7 +123,7 @@ def _drop_degenerate(vertices, faces):
 # ---------------------------------------------------------------------------
 # core array functions
 # ---------------------------------------------------------------------------
-def point_surface_distance(points, vertices, faces) -> tuple[np.ndarray, np.ndarray]:
+def point_surface_distance(points, vertices, faces, *, closest: bool = False) -> tuple:
     """Unsigned distance from points to a triangle mesh's surface, and the closest triangle.
 
     Parameters
@@ -138,6 +138,8 @@ def point_surface_distance(points, vertices, faces) -> tuple[np.ndarray, np.ndar
     face_index : (n,) int64
         Index (into ``faces``) of a closest triangle; at a point equidistant from several
         triangles (closest point on a shared edge or vertex) one of them.
+    closest_points : (n, 3) float64
+        Only with ``closest=True``: the closest point of the surface to each point.
 
     Notes
     -----
@@ -145,11 +147,12 @@ def point_surface_distance(points, vertices, faces) -> tuple[np.ndarray, np.ndar
     """
     import igl
 
-    sq, idx, _closest = igl.point_mesh_squared_distance(
+    sq, idx, near = igl.point_mesh_squared_distance(
         np.ascontiguousarray(points, dtype=np.float64),
         np.ascontiguousarray(vertices, dtype=np.float64),
         np.ascontiguousarray(faces, dtype=np.int64))
-    return np.sqrt(np.maximum(sq, 0.0)), np.asarray(idx, dtype=np.int64)
+    out = np.sqrt(np.maximum(sq, 0.0)), np.asarray(idx, dtype=np.int64)
+    return out + (np.asarray(near, dtype=np.float64),) if closest else out
 
 
 def _check_options(n_samples, threshold):

@@ -6,8 +6,11 @@ span area (seen in the plane of its two main directions, most of its convex hull
 lies near a curve, and its bounding rectangle is not a sliver) is *surface-like* and
 gets a neural fill when it carries at least :data:`MIN_FILL_LENGTH` of the curve length;
 any other region (a single stroke, legs, a stem, a small detail) stays as wires.
-:func:`plan_regions` makes that decision as data; :func:`trim_fill` keeps of a
-neural surface only the part that fills a region and does not overlap the patches.
+:func:`plan_regions` makes that decision as data. A fill is fitted to the region's
+strokes, the patch curves beside them and, as oriented points, samples of the patches
+along those curves (:func:`patch_anchors`), so that fill and patches meet there;
+:func:`trim_fill` keeps of it only the part that fills the region and does not lie
+over the patches, and :func:`fill_seam` measures how well the two meet.
 :func:`stroke_wires` keeps what the surface leaves out of the sketch: every stretch of a
 stroke farther from the surface than the fidelity tolerance (the strokes of wire regions,
 overshoots trimmed by the snapping, the second stroke of an overdrawn curve), with the
@@ -21,11 +24,12 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from .core.geometry import arc_length, cumulative_length, densify_polyline, interpolate_polyline
+from .core.geometry import (arc_length, cumulative_length, densify_polyline, face_normals_areas,
+                            interpolate_polyline, sample_surface)
 from .evaluate import FIDELITY_TOL_REL, STROKE_SPACING_REL, point_surface_distance, stroke_samples
 
-__all__ = ["REGION_GAP", "plan_regions", "region_strokes", "trim_fill", "assemble",
-           "stroke_wires"]
+__all__ = ["REGION_GAP", "plan_regions", "region_strokes", "patch_anchors", "trim_fill",
+           "close_seam", "fill_seam", "assemble", "stroke_wires"]
 
 #: curves closer than this fraction of the network's diagonal form one region
 REGION_GAP = 0.08
@@ -43,6 +47,13 @@ MIN_FILL_LENGTH = 0.1
 #: a stretch of stroke off the surface becomes a wire when it is at least this long,
 #: as a fraction of the sketch's diagonal (shorter ones are the surface's wobble)
 MIN_WIRE_LENGTH = 0.01
+#: a fill's anchors are samples of the patch faces within this fraction of REGION_GAP of
+#: the patch curves beside the region...
+ANCHOR_BAND = 0.5
+#: ...at most this many (area-weighted)
+MAX_ANCHORS = 2000
+#: ...on the patches the fill continues (:func:`patch_anchors`), in degrees
+CONTINUE_ANGLE = 135.0
 
 
 def _diagonal(curves) -> float:
@@ -146,9 +157,95 @@ def region_strokes(curves, region: dict, used, *, gap_rel: float = REGION_GAP) -
     return own + beside
 
 
+def _dense(curves, step: float) -> np.ndarray:
+    """The curves' points, densified to ``step``, as one (n, 3) array."""
+    return np.concatenate([densify_polyline(c, step) for c in curves])
+
+
+def _region_frame(points, region_pts, gap: float):
+    """Where the region lies from each point: unit direction and normal, each (n, 3).
+
+    From the (up to 32) nearest region points within ``gap``: the direction is their
+    mean offset, normalised; the normal is the least-variance direction of them (the
+    normal of the sheet they span). Both are zero where no region point is that near.
+    """
+    dist, idx = cKDTree(region_pts).query(points, k=32, distance_upper_bound=gap)
+    w = np.isfinite(dist)[..., None].astype(np.float64)                    # (n, k, 1)
+    near = np.concatenate([region_pts, np.zeros((1, 3))])[np.where(w[..., 0] > 0, idx,
+                                                                    len(region_pts))]
+    offset = ((near - points[:, None]) * w).sum(axis=1)
+    length = np.linalg.norm(offset, axis=1, keepdims=True)
+    direction = np.where(length > 0, offset / np.where(length > 0, length, 1.0), 0.0)
+    centred = (near - (near * w).sum(axis=1, keepdims=True)
+               / np.maximum(w.sum(axis=1, keepdims=True), 1.0)) * w
+    normal = np.linalg.eigh(np.einsum("nki,nkj->nij", centred, centred))[1][:, :, 0]
+    return direction, normal * (length > 0)
+
+
+def patch_anchors(vertices, faces, shared_curves, region_curves, *, gap: float,
+                  band_rel: float = ANCHOR_BAND, n: int = MAX_ANCHORS, seed=0):
+    """Oriented samples of the patches a fill continues across their shared curves.
+
+    A patch face is sampled when its centroid lies within ``band_rel * gap`` of a point
+    of a shared curve that is within ``gap`` of the region, on the far side of that
+    point from the region, and roughly parallel to the region there: the direction
+    from the point to the face and the one into the region make more than
+    :data:`CONTINUE_ANGLE` degrees, and its normal and the normal of the sheet the
+    region's nearby points span make less than 180 degrees minus that (either sign).
+    The fill continues those patches. The other patches at the curve meet the fill at
+    an angle (a box's side below an awning that continues its top); asking the fill to
+    pass through them too would ask one implicit surface to branch.
+
+    Parameters
+    ----------
+    vertices : (V, 3) float64
+    faces : (F, 3) int64
+        The classical surface.
+    shared_curves : list of (m, 3) float64
+        The patch curves beside the region (:func:`region_strokes`).
+    region_curves : list of (m, 3) float64
+        The region's own curves.
+    gap : float
+        The region gap, input units.
+    band_rel : float
+        Width of the band sampled, as a fraction of ``gap``.
+    n : int
+        Number of samples, area-weighted.
+    seed : int or numpy.random.Generator
+
+    Returns
+    -------
+    (points (n, 3) float64, normals (n, 3) float64) or None
+        The samples and their faces' unit normals (as the faces are oriented); None when
+        no face qualifies.
+    """
+    if not shared_curves or not len(faces):
+        return None
+    region_pts = _dense(region_curves, gap / 8)
+    pts = _dense(shared_curves, gap / 8)
+    pts = pts[cKDTree(region_pts).query(pts)[0] < gap]
+    if not len(pts):
+        return None
+    vertices, faces = np.asarray(vertices, np.float64), np.asarray(faces)
+    normals, areas = face_normals_areas(vertices, faces)
+    centroids = vertices[faces].mean(axis=1)
+    dist, at = cKDTree(pts).query(centroids)
+    away = centroids - pts[at]
+    away /= np.maximum(np.linalg.norm(away, axis=1, keepdims=True), np.finfo(float).tiny)
+    into, sheet = _region_frame(pts, region_pts, gap)
+    cos = np.cos(np.radians(CONTINUE_ANGLE))
+    beyond = ((away * into[at]).sum(axis=1) < cos) \
+        & (np.abs((normals * sheet[at]).sum(axis=1)) > -cos)
+    areas = np.where((dist < band_rel * gap) & beyond, areas, 0.0)
+    if not areas.sum() > 0:
+        return None
+    points, face = sample_surface(vertices, faces, n, seed, areas=areas)
+    return points, normals[face]
+
+
 def trim_fill(vertices, faces, region_curves, patch_vertices, patch_faces, *,
-              gap: float) -> np.ndarray:
-    """Faces of a neural surface that fill a region: near its curves, off the patches.
+              gap: float, patch_curves=(), on_curve: float = 0.0) -> np.ndarray:
+    """Faces of a neural surface that fill a region: near its curves, not over the patches.
 
     Parameters
     ----------
@@ -160,8 +257,14 @@ def trim_fill(vertices, faces, region_curves, patch_vertices, patch_faces, *,
     patch_vertices, patch_faces : arrays
         The classical surface.
     gap : float
-        Input units: kept faces have their centroid within ``gap`` of a region curve
-        and farther than ``gap / 4`` from the classical surface.
+        Input units: kept faces have their centroid within ``gap`` of a region curve.
+    patch_curves : list of (m, 3) float64
+        The curves the patches are bounded by.
+    on_curve : float
+        A face whose centroid lies within ``gap / 4`` of the classical surface is over a
+        patch and dropped, unless its closest point there lies within ``on_curve`` of a
+        patch curve: then it lies beyond the patch, across the curve where the two meet
+        (``on_curve = 0``: every face that near is dropped).
 
     Returns
     -------
@@ -169,12 +272,96 @@ def trim_fill(vertices, faces, region_curves, patch_vertices, patch_faces, *,
         The faces kept.
     """
     centroids = np.asarray(vertices)[np.asarray(faces)].mean(axis=1)
-    dense = np.concatenate([densify_polyline(c, gap / 4) for c in region_curves])
-    near = cKDTree(dense).query(centroids)[0] < gap
+    near = cKDTree(_dense(region_curves, gap / 4)).query(centroids)[0] < gap
     if len(patch_faces):
-        off = point_surface_distance(centroids, patch_vertices, patch_faces)[0] > gap / 4
-        near &= off
+        d, _, closest = point_surface_distance(centroids, patch_vertices, patch_faces,
+                                               closest=True)
+        over = d <= gap / 4
+        if len(patch_curves) and on_curve > 0:
+            tree = cKDTree(_dense(patch_curves, on_curve / 2))
+            over[over] = tree.query(closest[over])[0] >= on_curve
+        near &= ~over
     return near
+
+
+def _rim(faces) -> np.ndarray:
+    """(E, 2) vertex ids of the edges used by one face (the boundary of a mesh)."""
+    edges = np.sort(np.asarray(faces)[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+    edges, count = np.unique(edges, axis=0, return_counts=True)
+    return edges[count == 1]
+
+
+def close_seam(vertices, faces, patch_vertices, patch_faces, *, reach: float):
+    """The fill with its boundary vertices near the patches moved onto them.
+
+    Parameters
+    ----------
+    vertices : (V, 3) float64
+    faces : (F, 3) int64
+        The kept fill.
+    patch_vertices, patch_faces : arrays
+        The classical surface.
+    reach : float
+        Boundary vertices closer than this to the classical surface (input units) move
+        to their closest point there; no other vertex moves.
+
+    Returns
+    -------
+    vertices : (V, 3) float64
+        A new array.
+    moved : float
+        The longest move (0 when none).
+    """
+    vertices = np.array(vertices, dtype=np.float64)
+    ids = np.unique(_rim(faces))
+    if not len(ids) or not len(patch_faces):
+        return vertices, 0.0
+    d, _, closest = point_surface_distance(vertices[ids], patch_vertices, patch_faces,
+                                           closest=True)
+    near = d < reach
+    vertices[ids[near]] = closest[near]
+    return vertices, float(d[near].max()) if near.any() else 0.0
+
+
+def fill_seam(vertices, faces, shared_curves, *, gap: float, tol: float) -> dict:
+    """How a kept fill meets the patches along the curves they share.
+
+    The shared curves are sampled (step ``tol / 2``); the samples within ``gap / 2`` of
+    the fill are where the fill reaches them. There, the seam is met where the fill's
+    boundary (its edges used by one face) passes within ``tol``.
+
+    Parameters
+    ----------
+    vertices : (V, 3) float64
+    faces : (F, 3) int64
+        The kept fill.
+    shared_curves : list of (m, 3) float64
+        The patch curves beside the region.
+    gap, tol : float
+        Input units.
+
+    Returns
+    -------
+    dict
+        ``seam``: share of the reached shared-curve length where the fill's boundary is
+        within ``tol`` (None when the fill reaches no shared curve); ``seam_p95``: the
+        95th percentile of the distance there, input units (None likewise).
+    """
+    none = {"seam": None, "seam_p95": None}
+    faces = np.asarray(faces)
+    if not shared_curves or not len(faces):
+        return none
+    q = _dense(shared_curves, tol / 2)
+    q = q[point_surface_distance(q, vertices, faces)[0] < gap / 2]
+    rim = _rim(faces)
+    if not len(q) or not len(rim):
+        return none
+    ends = np.asarray(vertices, np.float64)[rim]                        # (E, 2, 3)
+    k = max(2, int(np.ceil(np.linalg.norm(ends[:, 1] - ends[:, 0], axis=1).max() / (tol / 4))))
+    t = np.linspace(0.0, 1.0, k)[None, :, None]
+    rim_pts = (ends[:, :1] + t * (ends[:, 1:] - ends[:, :1])).reshape(-1, 3)
+    d = cKDTree(rim_pts).query(q)[0]   # q is evenly spaced: its share is a length share
+    return {"seam": float(np.mean(d <= tol)), "seam_p95": float(np.percentile(d, 95))}
 
 
 def stroke_wires(strokes, vertices, faces, *, tol_rel: float = FIDELITY_TOL_REL,
@@ -255,20 +442,42 @@ def add_wires(out) -> None:
 
 
 def _fill(out, classical, region, used, gap, plan, settings, run):
-    """One region's neural fill, trimmed: ``(vertices, faces)`` of the kept part."""
+    """One region's neural fill, trimmed: ``(vertices, faces)`` of the kept part.
+
+    The fit gets the region's strokes, the patch curves beside them and the patches'
+    samples along those curves (:func:`patch_anchors`); the kept part's boundary is
+    moved onto the patches where it lies within ``gap / 4`` of them (:func:`close_seam`).
+    ``region`` gets ``faces``, ``anchors``, the :func:`fill_seam` figures of the fit
+    (``seam_fit``, ``seam_fit_p95``) and of the result (``seam``, ``seam_p95``) and the
+    longest move ``seam_moved`` (lengths as fractions of the network's diagonal).
+    """
     from .surfacers import SurfaceInput
-    edges = out.network.edges
-    ids = region_strokes([e.curve for e in edges], region, used)
+    curves = [e.curve for e in out.network.edges]
+    ids = region_strokes(curves, region, used)
+    own = [curves[i] for i in region["curves"]]
+    shared = [curves[i] for i in ids[len(own):]]
+    anchors = patch_anchors(classical.vertices, classical.faces, shared, own, gap=gap,
+                            seed=settings.seed)
     # every stroke of a fill is a boundary: the fill needs no crease refit of its own
-    inp = SurfaceInput(settings, strokes=[edges[i].curve for i in ids],
-                       labels=["boundary"] * len(ids))
+    inp = SurfaceInput(settings, strokes=[curves[i] for i in ids],
+                       labels=["boundary"] * len(ids), anchors=anchors)
     fill = run(plan.stroke, inp, plan.options[plan.stroke.name], out.timings, out.diagnostics)
-    keep = trim_fill(fill.vertices, fill.faces, [edges[i].curve for i in region["curves"]],
-                     classical.vertices, classical.faces, gap=gap)
+    tol = FIDELITY_TOL_REL * _diagonal(curves)
+    keep = trim_fill(fill.vertices, fill.faces, own, classical.vertices, classical.faces,
+                     gap=gap, patch_curves=[curves[i] for i in np.flatnonzero(used)],
+                     on_curve=tol / 2)
     faces = np.asarray(fill.faces)[keep]
     kept, inverse = np.unique(faces, return_inverse=True)
-    region["faces"] = int(len(faces))
-    return np.asarray(fill.vertices)[kept], inverse.reshape(-1, 3)
+    verts, faces = np.asarray(fill.vertices)[kept], inverse.reshape(-1, 3)
+    fitted = fill_seam(verts, faces, shared, gap=gap, tol=tol)
+    verts, moved = close_seam(verts, faces, classical.vertices, classical.faces, reach=gap / 4)
+    closed = fill_seam(verts, faces, shared, gap=gap, tol=tol)
+    rel = FIDELITY_TOL_REL / tol       # input units -> fractions of the diagonal
+    region.update(faces=int(len(faces)), anchors=0 if anchors is None else len(anchors[0]),
+                  seam_fit=fitted["seam"], seam=closed["seam"], seam_moved=moved * rel,
+                  **{k: None if v is None else v * rel for k, v in
+                     (("seam_fit_p95", fitted["seam_p95"]), ("seam_p95", closed["seam_p95"]))})
+    return verts, faces
 
 
 def assemble(out, classical, plan, settings, run) -> None:

@@ -89,6 +89,9 @@ class SurfaceInput:
         One label per stroke (``needs="strokes"``).
     init_mesh : tuple of ((n, 3) float64, (f, 3) int64) or None
         A surface to refine (``needs="strokes"``, refinement only).
+    anchors : tuple of ((m, 3) float64, (m, 3) float64) or None
+        Points and unit normals of a surface the result must meet (``needs="strokes"``:
+        the classical patches beside a hybrid fill, :func:`curvenet.hybrid.patch_anchors`).
     """
 
     settings: SurfaceSettings = field(default_factory=SurfaceSettings)
@@ -99,6 +102,7 @@ class SurfaceInput:
     strokes: list = field(default_factory=list)
     labels: list = field(default_factory=list)
     init_mesh: tuple | None = None
+    anchors: tuple | None = None
 
 
 def _resolve(ref):
@@ -327,7 +331,7 @@ def _neural(inp: SurfaceInput, options: dict) -> MeshResult:
     crease_options = flow_options.pop("creases", None) or {}
     res = flow.fit_flow_surface(inp.strokes, labels=inp.labels, quality=s.quality,
                                 device=s.device, seed=s.seed, init_mesh=inp.init_mesh,
-                                progress=s.progress, **flow_options)
+                                anchors=inp.anchors, progress=s.progress, **flow_options)
     verts, faces, report = res.vertices, res.faces, dict(res.report)
     if "crease" in inp.labels and not report.get("interrupted"):
         cres = creases.crease_refine(verts, faces, inp.strokes, inp.labels, quality=s.quality,

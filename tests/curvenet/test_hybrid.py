@@ -205,3 +205,112 @@ def test_a_round_plate_of_strokes_is_surface_like():
     dense = np.concatenate([densify_polyline(c, gap / 8) for c in curves])[:, :2]
     from scipy.spatial import cKDTree
     assert np.mean(cKDTree(dense).query(g)[0] < gap) < FILL_SHARE
+
+
+def _grid_sheet(x0, x1, y0, y1, z, n=21):
+    """A flat triangulated sheet z = const over [x0, x1] x [y0, y1] (the fill of the tests)."""
+    import trimesh
+    u, v = np.meshgrid(np.linspace(x0, x1, n), np.linspace(y0, y1, n), indexing="ij")
+    verts = np.c_[u.ravel(), v.ravel(), 0 * u.ravel() + z]
+    k = np.arange(n * n).reshape(n, n)
+    a, b, c, d = k[:-1, :-1].ravel(), k[1:, :-1].ravel(), k[1:, 1:].ravel(), k[:-1, 1:].ravel()
+    return trimesh.Trimesh(verts, np.r_[np.c_[a, b, c], np.c_[a, c, d]], process=False)
+
+
+def _unit_box():
+    import trimesh
+    return trimesh.creation.box(bounds=[[0, 0, 0], [1, 1, 1]])
+
+
+#: an awning of strokes leaving the unit box's top edge at x = 1 (they bound nothing)
+_AWNING = [np.c_[1.0 + 0.8 * T, 0 * T + y, 0 * T + 1.0] for y in np.linspace(0.1, 0.9, 6)]
+_TOP_EDGE = np.c_[0 * T + 1.0, T, 0 * T + 1.0]
+
+
+def test_anchors_sample_the_patch_the_fill_continues():
+    """The awning continues the top face: its anchors lie on the top (normals +-z) near
+    the shared edge, none on the side face x = 1 it meets at a right angle."""
+    from curvenet.hybrid import patch_anchors
+    box = _unit_box().subdivide().subdivide().subdivide()
+    gap = 0.2
+    pts, normals = patch_anchors(box.vertices, box.faces, [_TOP_EDGE], _AWNING, gap=gap,
+                                 n=500, seed=1)
+    assert pts.shape == normals.shape == (500, 3)
+    np.testing.assert_allclose(pts[:, 2], 1.0, atol=1e-12)
+    np.testing.assert_allclose(np.abs(normals[:, 2]), 1.0, atol=1e-12)
+    # faces whose centroid is within half a gap of the edge (faces are 1/8 wide)
+    assert pts[:, 0].min() > 1.0 - 0.5 * gap - 1 / 8 and pts[:, 0].max() <= 1.0
+    assert 0.0 <= pts[:, 1].min() < 0.1 and 0.9 < pts[:, 1].max() <= 1.0
+    # a region that touches no shared curve gets no anchors
+    far = [c + [3.0, 0.0, 0.0] for c in _AWNING]
+    assert patch_anchors(box.vertices, box.faces, [_TOP_EDGE], far, gap=gap) is None
+
+
+def test_trim_keeps_the_fill_beyond_the_shared_curve_and_drops_it_over_the_patch():
+    from curvenet.hybrid import trim_fill
+    box = _unit_box()
+    # the fill continues the top face across its edge x = 1 and overlaps it by 0.3
+    fill = _grid_sheet(0.7, 1.8, 0.1, 0.9, 1.0 + 1e-3, n=45)
+    ends = box.vertices[box.edges_unique]
+    edges = list(ends[(ends[:, 0] != ends[:, 1]).sum(axis=1) == 1])   # the 12, not diagonals
+    centres = fill.triangles_center
+    for on_curve, lost in ((0.01, 0.02), (0.0, 0.2)):
+        keep = trim_fill(fill.vertices, fill.faces, _AWNING, box.vertices, box.faces, gap=0.2,
+                         patch_curves=edges, on_curve=on_curve)
+        assert not keep[centres[:, 0] < 1.0 - on_curve].any()     # over the top face
+        # beyond the edge: kept from the edge on (without on_curve, only past gap / 4)
+        beyond = centres[:, 0] > 1.0 + lost
+        assert keep[beyond & (centres[:, 0] < 1.6)].all()
+
+
+def test_fill_seam_is_the_share_of_the_shared_curve_where_the_fill_boundary_meets_it():
+    from curvenet.hybrid import fill_seam
+    tol = 0.02
+    met = _grid_sheet(1.0, 1.8, 0.0, 1.0, 1.0)
+    assert fill_seam(met.vertices, met.faces, [_TOP_EDGE], gap=0.2, tol=tol) == \
+        {"seam": 1.0, "seam_p95": pytest.approx(0.0, abs=tol / 8)}
+    # the half of the edge (y < 0.5) where the fill stops 3 tol short of it
+    half = _grid_sheet(1.0, 1.8, 0.5, 1.0, 1.0)
+    short = _grid_sheet(1.0 + 3 * tol, 1.8, 0.0, 0.5, 1.0)
+    both = trimesh_concat(half, short)
+    seam = fill_seam(both.vertices, both.faces, [_TOP_EDGE], gap=0.2, tol=tol)
+    assert seam["seam"] == pytest.approx(0.5, abs=0.03)
+    assert seam["seam_p95"] == pytest.approx(3 * tol, rel=0.02)
+    # a fill that reaches no shared curve has no seam
+    away = _grid_sheet(3.0, 3.8, 0.0, 1.0, 1.0)
+    assert fill_seam(away.vertices, away.faces, [_TOP_EDGE], gap=0.2, tol=tol) == \
+        {"seam": None, "seam_p95": None}
+
+
+def trimesh_concat(*meshes):
+    import trimesh
+    return trimesh.util.concatenate(meshes)
+
+
+#: neural settings small enough for a test (seconds), large enough for a fill
+_SMALL_NEURAL = dict(res=40, steps=40, init_steps=20, geometric_init_steps=50)
+
+
+def test_a_fill_beside_patches_meets_them_along_the_shared_curve():
+    """A closed box with a drooping awning of loose strokes leaving its top edge x = 1: the
+    fill is fitted with samples of the top face as data and meets the box along the edge."""
+    from curvenet.hybrid import fill_seam
+    awning = [np.c_[1.0 + 0.8 * T, 0 * T + y, 1.0 - 0.25 * T ** 2]
+              for y in np.linspace(0.1, 0.9, 6)]
+    sk = shapes.box().sketch()
+    sketch = Sketch(sk.strokes + awning, list(sk.labels) + ["boundary"] * 6)
+    res = curvenet.surface(sketch, neural_options=_SMALL_NEURAL)
+    assert res.method == "hybrid"
+    region = res.decision.regions[1]
+    assert region["route"] == "neural" and region["anchors"] > 0
+    assert 0 < region["seam_moved"] <= 0.08 / 4        # moves stay within gap / 4
+    tol = 0.01 * res.diagnostics["fidelity"]["diagonal"]
+    faces = res.mesh.faces[res.face_route == 1]
+    centres = res.mesh.vertices[faces].mean(axis=1)
+    # nothing of the fill lies on the box's top face (that part is the patch's)
+    assert not ((centres[:, 0] < 1.0 - tol) & (np.abs(centres[:, 2] - 1.0) < 0.05)).any()
+    # the fill's boundary runs along the shared edge where the awning leaves it
+    edge = np.c_[0 * T + 1.0, 0.15 + 0.7 * T, 0 * T + 1.0]
+    seam = fill_seam(res.mesh.vertices, faces, [edge], gap=0.08, tol=tol)
+    assert seam["seam"] >= 0.9 and seam["seam_p95"] < 2 * tol
+    assert region["seam"] >= 0.6 and region["seam"] >= region["seam_fit"]
