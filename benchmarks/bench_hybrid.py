@@ -3,6 +3,7 @@
 Run from the repository root::
 
     nice -n 10 python benchmarks/bench_hybrid.py --out hybrid.tsv [--sets cassie,vns]
+        [--sketches 01-1-1,guitar] [--hybrid-only]
 
 Inputs: every sketch in ``$CURVENET_DATA/sketches/cassie/curves`` and
 ``$CURVENET_DATA/sketches/vns`` (default ``../shared/data``). Each is surfaced with
@@ -10,7 +11,14 @@ Inputs: every sketch in ``$CURVENET_DATA/sketches/cassie/curves`` and
 appended to ``--out`` as soon as it is done (a run stopped early keeps its rows): the
 route, the seconds, and the share of stroke length within 1% of the sketch's diagonal
 of the surface alone and of the surface and the wires kept beside it (when the result
-has any), with the median and 95th percentile of the stroke-to-surface distance.
+has any), with the median and 95th percentile of the stroke-to-surface distance. For the
+neural fills of hybrid results, the seam figures of :func:`curvenet.hybrid.fill_seam`
+(one value per fill, comma-separated): ``seam_fit`` and ``seam`` (share of the reached
+patch-shared curve length where the fill's boundary lies within 1% of the diagonal, as
+fitted and after :func:`curvenet.hybrid.close_seam`), ``seam_p95`` (95th percentile of
+that distance, fraction of the diagonal). ``--sketches`` runs only the sketches of those
+names (file stems); ``--hybrid-only`` only those that :data:`HYBRID` lists (the sketches
+``auto`` surfaces with a neural fill).
 """
 
 from __future__ import annotations
@@ -30,7 +38,17 @@ DATA = Path(os.environ.get("CURVENET_DATA",
 SETS = {"cassie": ("sketches/cassie/curves", "*.curves"),
         "vns": ("sketches/vns", "*.obj")}
 COLUMNS = ("set", "sketch", "route", "seconds", "surface_1pct", "with_wires_1pct",
-           "wire_share", "median", "p95")
+           "wire_share", "median", "p95", "seam_fit", "seam", "seam_p95")
+#: the sketches ``auto`` surfaces with a neural fill (benchmarks/README.md)
+HYBRID = ("01-0-1", "01-1-1", "05-0-1", "05-0-2", "06-1-2", "guitar", "shield", "vintage_car",
+          "bulbasaur", "ok_hand")
+
+
+def _seams(res, key: str, fmt: str) -> str:
+    """One value per neural fill of ``res`` ("-" when there is none)."""
+    regions = res.decision.regions if res.decision is not None else []
+    vals = [r.get(key) for r in regions if r["route"] == "neural"]
+    return ",".join("-" if v is None else format(v, fmt) for v in vals) or "-"
 
 
 def _row(set_name: str, path: Path) -> dict:
@@ -48,20 +66,27 @@ def _row(set_name: str, path: Path) -> dict:
     return {"set": set_name, "sketch": path.name, "route": route, "seconds": f"{seconds:.1f}",
             "surface_1pct": f"{fid['surface']:.3f}", "with_wires_1pct": f"{fid['with_wires']:.3f}",
             "wire_share": f"{fid['wire_share']:.3f}", "median": f"{fid['median']:.2e}",
-            "p95": f"{fid['p95']:.2e}"}
+            "p95": f"{fid['p95']:.2e}", "seam_fit": _seams(res, "seam_fit", ".3f"),
+            "seam": _seams(res, "seam", ".3f"), "seam_p95": _seams(res, "seam_p95", ".4f")}
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", required=True, help="TSV table, one row per sketch")
     ap.add_argument("--sets", default="cassie,vns")
+    ap.add_argument("--sketches", default="", help="comma-separated names (file stems)")
+    ap.add_argument("--hybrid-only", action="store_true", help="only the sketches of HYBRID")
     args = ap.parse_args()
+    names = set(filter(None, args.sketches.split(","))) | (set(HYBRID) if args.hybrid_only
+                                                           else set())
     out = Path(args.out)
     with open(out, "w") as fh:
         fh.write("\t".join(COLUMNS) + "\n")
     for set_name in args.sets.split(","):
         folder, pattern = SETS[set_name]
         for path in sorted((DATA / folder).glob(pattern)):
+            if names and path.stem not in names:
+                continue
             try:
                 row = _row(set_name, path)
             except Exception as err:  # noqa: BLE001 - a failed sketch is a row, not the end

@@ -80,10 +80,16 @@ class RouteDecision:
         return f"{self.method}: " + REASONS[self.reason].format(**asdict(self))
 
     def explain_regions(self) -> list:
-        """One line per region: ``"<route>: <n> curves, <share> of the curve length"``."""
+        """One line per region: ``"<route>: <n> curves, <share> of the curve length"``.
+
+        A neural fill's line also says along what share of the patch curves it reaches
+        it meets the patches (``seam``, :func:`curvenet.hybrid.fill_seam`).
+        """
         total = sum(r["length"] for r in self.regions) or 1.0
         return [f"{r['route']}: {len(r['curves'])} curves, {r['length'] / total:.0%} of the "
                 f"curve length" + (f" ({r['patches']} patches)" if "patches" in r else "")
+                + (f"; meets the patches along {r['seam']:.0%} of the shared curves it "
+                   f"reaches" if r.get("seam") is not None else "")
                 for r in self.regions]
 
 

@@ -314,3 +314,4 @@ def test_a_fill_beside_patches_meets_them_along_the_shared_curve():
     seam = fill_seam(res.mesh.vertices, faces, [edge], gap=0.08, tol=tol)
     assert seam["seam"] >= 0.9 and seam["seam_p95"] < 2 * tol
     assert region["seam"] >= 0.6 and region["seam"] >= region["seam_fit"]
+    assert f"meets the patches along {region['seam']:.0%}" in res.decision.explain_regions()[1]
