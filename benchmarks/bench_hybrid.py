@@ -17,8 +17,8 @@ neural fills of hybrid results, the seam figures of :func:`curvenet.hybrid.fill_
 patch-shared curve length where the fill's boundary lies within 1% of the diagonal, as
 fitted and after :func:`curvenet.hybrid.close_seam`), ``seam_p95`` (95th percentile of
 that distance, fraction of the diagonal). ``--sketches`` runs only the sketches of those
-names (file stems); ``--hybrid-only`` only those that :data:`HYBRID` lists (the sketches
-``auto`` surfaces with a neural fill).
+names (file stems, or ``SET/STEM``); ``--hybrid-only`` only those that :data:`HYBRID`
+lists (the sketches ``auto`` surfaces with a neural fill).
 """
 
 from __future__ import annotations
@@ -40,8 +40,9 @@ SETS = {"cassie": ("sketches/cassie/curves", "*.curves"),
 COLUMNS = ("set", "sketch", "route", "seconds", "surface_1pct", "with_wires_1pct",
            "wire_share", "median", "p95", "seam_fit", "seam", "seam_p95")
 #: the sketches ``auto`` surfaces with a neural fill (benchmarks/README.md)
-HYBRID = ("01-0-1", "01-1-1", "05-0-1", "05-0-2", "06-1-2", "guitar", "shield", "vintage_car",
-          "bulbasaur", "ok_hand")
+HYBRID = tuple(f"cassie/{n}" for n in ("01-0-1", "01-1-1", "05-0-1", "05-0-2", "06-1-2",
+                                        "guitar", "shield", "vintage_car")) \
+    + ("vns/bulbasaur", "vns/ok_hand")
 
 
 def _seams(res, key: str, fmt: str) -> str:
@@ -74,7 +75,8 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", required=True, help="TSV table, one row per sketch")
     ap.add_argument("--sets", default="cassie,vns")
-    ap.add_argument("--sketches", default="", help="comma-separated names (file stems)")
+    ap.add_argument("--sketches", default="",
+                    help="comma-separated names: file stems or SET/STEM")
     ap.add_argument("--hybrid-only", action="store_true", help="only the sketches of HYBRID")
     args = ap.parse_args()
     names = set(filter(None, args.sketches.split(","))) | (set(HYBRID) if args.hybrid_only
@@ -85,7 +87,7 @@ def main() -> None:
     for set_name in args.sets.split(","):
         folder, pattern = SETS[set_name]
         for path in sorted((DATA / folder).glob(pattern)):
-            if names and path.stem not in names:
+            if names and not {path.stem, f"{set_name}/{path.stem}"} & names:
                 continue
             try:
                 row = _row(set_name, path)
