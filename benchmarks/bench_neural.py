@@ -16,8 +16,11 @@ reference  ``default`` on an 18-stroke rough sphere: time, peak memory, F-score,
 spheres    ``--reference-quality`` (default ``default``) on the rough spheres of sketch seeds
            ``--seeds`` (0-4): F-score at 0.01 and Chamfer against the true sphere, wall and
            CPU seconds of the fit, peak RSS; ``--set NAME=VALUE`` overrides settings
-vns        time per sketch (``--vns-quality``, default draft) on several vns sketches,
-           PNG previews under ``--png-dir`` (default /tmp)
+vns        time and stroke fidelity per sketch (``--vns-quality``, default draft) on
+           several vns sketches (``--vns all``: every ``*.obj`` under sketches/vns), PNG
+           previews under ``--png-dir`` (default /tmp); fidelity is the share of stroke
+           length within 1 % of the sketch's diagonal of the surface, as ``curvenet eval``
+           reports it (:func:`curvenet.evaluate.sketch_fidelity`)
 
 Measured 2026-11-24 on the shared 2-core CPU (load average 3-7 from other engineers;
 alone, draft takes ~12-16 s per sketch, as phone_flowrep/trebol show):
@@ -86,6 +89,9 @@ def _worker(spec: dict) -> dict:
     out["peak_gb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e6
     if device.startswith("cuda"):
         out["gpu_peak_gb"] = torch.cuda.max_memory_allocated() / 1e9
+    if spec["kind"] == "sketch" and len(r.faces):
+        from curvenet.evaluate import sketch_fidelity
+        out["fidelity"] = sketch_fidelity((r.vertices, r.faces), sk)["surface"]
     if spec["kind"] == "sphere":
         from tests.neural._metrics import fscore
         ref = shape.reference_mesh(5)
@@ -146,7 +152,8 @@ def main(argv=None):
     ap.add_argument("--only", nargs="*", default=["draft100", "steps", "reference", "vns"])
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--vns", nargs="*", default=["bulbasaur", "guitar", "phone_flowrep",
-                                                  "trebol_flowrep", "torus"])
+                                                  "trebol_flowrep", "torus"],
+                    help="sketch names under sketches/vns (without .obj), or all")
     ap.add_argument("--device", default="cpu", help="cpu or cuda")
     ap.add_argument("--reference-quality", default="default",
                     help="preset of the rough-sphere comparison (default: default)")
@@ -210,13 +217,19 @@ def main(argv=None):
                  f"{r['chamfer']:.2e}", f"{r['time_s']:.1f}s", f"{r['cpu_s']:.1f}s",
                  _memory(r))
     if "vns" in a.only:
-        for name in a.vns:
+        names = a.vns
+        if names == ["all"]:
+            names = [p.relative_to(vns).with_suffix("").as_posix()
+                     for p in sorted(vns.rglob("*.obj"))]
+        for name in names:
             path = vns / f"{name}.obj"
             r = _run({**base, "kind": "sketch", "path": str(path), "quality": a.vns_quality,
                       "png": str(png / f"neural_{Path(name).name}.png")})
             _row("vns", a.vns_quality, name, f"strokes={r.get('strokes')}",
-                 f"time={r.get('time_s', float('nan')):.1f}s", f"faces={r.get('faces')}",
-                 _memory(r), r.get("error", ""))
+                 f"time={r.get('time_s', float('nan')):.1f}s",
+                 f"cpu={r.get('cpu_s', float('nan')):.1f}s", f"faces={r.get('faces')}",
+                 f"fidelity={r.get('fidelity', float('nan')):.3f}", _memory(r),
+                 r.get("error", ""))
     print(f"# load average at end: {os.getloadavg()}")
 
 

@@ -30,6 +30,11 @@ Engineering choices (documented deviations / gap fills)
   ``normalize_from`` of the full stage on: each node's sum is divided by
   ``max(weight sum, mean positive weight sum)``, which removes the density bias
   of the stroke samples without inflating sparsely hit nodes.
+* ``stroke_strip > 0`` (off in every preset): the surface samples within that
+  many cells of a stroke sample are left out of the splat and the stroke
+  samples carry their mass (:func:`neural.poisson.stroke_strip`),
+  so the splat has one density along the surface; the paper splats the stroke
+  samples on top of the surface ones.
 * ``geometric_init_steps > 0`` (draft, default) first fits g to the gradient
   ``sigma (x - c) / |x - c|`` of a sphere around the stroke centroid c (cheap:
   no derivatives), a geometric initialisation like the published code's
@@ -428,15 +433,16 @@ class _FlowFit:
             full = Stage("full", cfg.steps, self._flow_step("full", cfg.steps))
         return [first, full]
 
-    def solve(self, points, values, normalize, need_adjoint, n_stroke=None):
+    def solve(self, points, values, normalize, need_adjoint, n_stroke=None, mass=None):
         """Splat -> FFT Poisson -> Eq. 11; returns (f_grid, data loss, raw grid).
 
         The first ``n_stroke`` (default ``cfg.n_stroke``) points are the data samples
-        (the stroke samples, then the anchors').
+        (the stroke samples, then the anchors'); ``mass`` (optional, (M,)) weighs the
+        points in the splat.
         """
         from .losses import data_loss
         from .poisson import interpolate, normalize_scale_shift, normalize_splat, splat
-        grid, wsum = splat(points, values, self.cfg.res)
+        grid, wsum = splat(points, values, self.cfg.res, mass)
         raw = grid
         if need_adjoint:
             raw.retain_grad()
@@ -459,11 +465,12 @@ class _FlowFit:
         import torch
         cfg = self.cfg
         with torch.no_grad():
-            pts = self._data_points(factor)
-            n_data = len(pts)
+            x_s = self._data_points(factor)
             x_u = sample_surface_cells(f, factor * cfg.n_surface, self.gen)
-            if x_u is not None:
-                pts = torch.cat([pts, x_u])
+            keep, mass = self._strip(x_s, x_u)
+            if keep is not None:
+                x_u = x_u[keep]
+            pts = x_s if x_u is None else torch.cat([x_s, x_u])
             vals = torch.cat([self.net(p) for p in pts.split(65536)])
             normalize = cfg.steps - 1 >= int(cfg.normalize_from * cfg.steps)   # as the last step
             if cfg.polish_smooth_cells != cfg.smooth_cells:
@@ -471,7 +478,7 @@ class _FlowFit:
                 self.solver = PoissonSolver(cfg.res, device=self.dev, dtype=self.dtype,
                                             smooth_cells=cfg.polish_smooth_cells,
                                             boundary=cfg.boundary)
-            return self.solve(pts, vals, normalize, False, n_stroke=n_data)[0]
+            return self.solve(pts, vals, normalize, False, n_stroke=len(x_s), mass=mass)[0]
 
     def solve_strokes_only(self, mesh_points=None):
         """f integrated from g at stroke samples (and ``mesh_points``), without gradients."""
@@ -553,17 +560,19 @@ class _FlowFit:
             x_u = self._surface_samples(cfg.n_surface) if full else None
             vals = {"align": alignment_loss(g_s, G_s, t_s), "curl": curl_loss(G_sv[cfg.n_stroke:])}
             x_s, g_s = self._anchor_terms(vals, x_s, g_s)
-            pts, gv = self._surface_terms(vals, x_u, x_s, g_s)
+            pts, gv, mass = self._surface_terms(vals, x_u, x_s, g_s)
             if cfg.splat_volume:
                 pts, gv = torch.cat([pts, x_v]), torch.cat([gv, g_sv[cfg.n_stroke:]])
+                if mass is not None:
+                    mass = torch.cat([mass, mass.new_ones(len(x_v))])
             normalize = full and k >= int(cfg.normalize_from * n_steps)
             do_solve = (k % cfg.poisson_every == 0) or k == n_steps - 1 or self.lam is None
             if do_solve:
                 f, vals["data"], raw = self.solve(pts, gv, normalize, cfg.poisson_every > 1,
-                                                  n_stroke=len(x_s))
+                                                  n_stroke=len(x_s), mass=mass)
                 data_term = cfg.w_data * vals["data"]
             else:
-                data_term = (self.lam * splat(pts, gv, cfg.res)[0]).sum()
+                data_term = (self.lam * splat(pts, gv, cfg.res, mass)[0]).sum()
             loss = (cfg.w_align * vals["align"] + cfg.w_curl * vals["curl"]
                     + cfg.w_eik * vals["eik"] + data_term)
             for term, w in (("smooth", cfg.w_smooth), ("normal", cfg.w_normal)):
@@ -589,15 +598,23 @@ class _FlowFit:
 
         return step
 
+    def _strip(self, x_s, x_u):
+        """``(keep, mass)`` of :func:`neural.poisson.stroke_strip` (``cfg.stroke_strip``
+        cells); ``(None, None)``, all splatted with mass 1, without x_u or strip."""
+        if x_u is None or self.cfg.stroke_strip <= 0:
+            return None, None
+        from .poisson import stroke_strip
+        return stroke_strip(x_s, x_u, self.cfg.stroke_strip / self.cfg.res)
+
     def _surface_terms(self, vals, x_u, x_s, g_s):
-        """Smoothness and Eikonal terms into ``vals``; the points and g to splat."""
+        """Smoothness and Eikonal terms into ``vals``; the points, g and masses to splat."""
         import torch
 
         from .losses import eikonal_loss, smoothness_loss, smoothness_loss_autograd
         cfg, net = self.cfg, self.net
         if x_u is None:
             vals["eik"] = eikonal_loss(g_s, cfg.sigma)
-            return x_s, g_s
+            return x_s, g_s, None
         if cfg.w_smooth > 0 and cfg.smooth_mode == "jet":
             g_u, G_u, H_u = net.jet(x_u, order=2)
             vals["smooth"] = smoothness_loss(g_u, G_u, H_u)
@@ -606,7 +623,10 @@ class _FlowFit:
             if cfg.w_smooth > 0:
                 vals["smooth"] = smoothness_loss_autograd(net, x_u)
         vals["eik"] = eikonal_loss(torch.cat([g_u, g_s]), cfg.sigma)
-        return torch.cat([x_s, x_u]), torch.cat([g_s, g_u])
+        keep, mass = self._strip(x_s, x_u)
+        if keep is not None:
+            x_u, g_u = x_u[keep], g_u[keep]
+        return torch.cat([x_s, x_u]), torch.cat([g_s, g_u]), mass
 
     def _row(self, vals) -> list:
         """The loss terms of :data:`_TERMS` as floats (NaN where not computed)."""

@@ -27,8 +27,8 @@ import torch
 
 from curvenet.core.tolerances import NORM_EPS, TINY_F32
 
-__all__ = ["PoissonSolver", "splat", "normalize_splat", "interpolate", "normalize_scale_shift",
-           "trilinear_stencil"]
+__all__ = ["PoissonSolver", "splat", "stroke_strip", "normalize_splat", "interpolate",
+           "normalize_scale_shift", "trilinear_stencil"]
 
 
 def trilinear_stencil(points: torch.Tensor, res: int):
@@ -59,7 +59,7 @@ def trilinear_stencil(points: torch.Tensor, res: int):
     return idx, w, frac, corners
 
 
-def splat(points: torch.Tensor, values: torch.Tensor, res: int):
+def splat(points: torch.Tensor, values: torch.Tensor, res: int, weights=None):
     """Rasterise point values onto the grid by trilinear weights (Sec. 5.1).
 
     Parameters
@@ -67,6 +67,9 @@ def splat(points: torch.Tensor, values: torch.Tensor, res: int):
     points : (M, 3) unit-cube coordinates (no gradient needed)
     values : (M, C), differentiable
     res : int
+    weights : (M,) tensor, optional
+        Mass of each point (default 1): its value and its trilinear weights are
+        multiplied by it.
 
     Returns
     -------
@@ -74,6 +77,8 @@ def splat(points: torch.Tensor, values: torch.Tensor, res: int):
     weight : (res, res, res), sum of weights per node
     """
     idx, w, _, _ = trilinear_stencil(points.detach(), res)
+    if weights is not None:
+        w = w * weights.detach().to(w.dtype).unsqueeze(-1)
     C = values.shape[1]
     flat = idx.reshape(-1)
     src = (w.unsqueeze(-1) * values.unsqueeze(1)).reshape(-1, C)  # (M*8, C)
@@ -82,6 +87,42 @@ def splat(points: torch.Tensor, values: torch.Tensor, res: int):
     wsum = torch.zeros(res ** 3, dtype=values.dtype, device=values.device)
     wsum = wsum.index_add(0, flat, w.reshape(-1).to(values.dtype))
     return grid.t().reshape(C, res, res, res), wsum.reshape(res, res, res)
+
+
+def stroke_strip(x_s, x_u, width: float, *, chunk: int = 2048):
+    """Surface samples off the strokes' strip, and the mass the stroke samples take over.
+
+    The strokes lie on the surface, so splatting stroke samples beside the surface
+    samples counts the surface along the strokes twice. That extra density is a
+    curved line of normals; its potential at the stroke itself, where Eq. 11 sets the
+    zero level, differs from its potential elsewhere on the surface, so the zero set
+    between strokes moves towards the concave side (a rough sphere shrinks between
+    its strokes). Dropping the surface samples closer than ``width`` to a stroke
+    sample and giving the stroke samples their mass keeps one density along the
+    whole surface. Where the surface folds at a stroke (the rim of an open
+    surface) the extra density is also what holds it on the stroke, so the fits
+    leave this off (:mod:`neural.presets`).
+
+    Parameters
+    ----------
+    x_s : (n_s, 3) tensor, stroke samples
+    x_u : (n_u, 3) tensor, surface samples (same device and dtype)
+    width : float
+        Strip half-width, unit-cube units.
+    chunk : int
+        Surface samples per distance block (bounds memory to ``chunk * n_s``).
+
+    Returns
+    -------
+    keep : (n_u,) bool tensor, the surface samples outside the strip
+    mass : (n_s + kept,) tensor, the masses of the stroke samples, ``k / n_s`` each for
+        the ``k`` surface samples dropped (1 when none is), then of the kept ones (1)
+    """
+    near = torch.cat([torch.cdist(block, x_s).amin(1) < width for block in x_u.split(chunk)])
+    k = int(near.sum())
+    mass = x_s.new_ones(len(x_s) + len(x_u) - k)
+    mass[: len(x_s)] = k / len(x_s) if k else 1.0
+    return ~near, mass
 
 
 def normalize_splat(grid: torch.Tensor, weight: torch.Tensor) -> torch.Tensor:

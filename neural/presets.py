@@ -20,12 +20,20 @@ balances quality and time (128^3) and is the better choice on a GPU. Both raise 
 smoothness weight from the paper's 0.01 to 0.1 and start from a radial geometric
 initialisation: with their short budgets the paper's weight leaves mid-frequency
 bumps, and the plain SIREN initialisation starts from a rough field they cannot
-recover from. ``polish`` (off in every preset) re-integrates the final f from more
-samples: closer to rough spheres, but off the strokes of a sketch of three boundary
-strokes (``benchmarks/README.md``). ``paper`` keeps the published
-constants (no variant tried was better on every test shape). All presets solve the
-Poisson equation every ``poisson_every`` steps and use the linearised data term in
-between (see :mod:`neural.flow`).
+recover from. Every preset splats the stroke samples on top of the surface
+samples, as the paper and the published code do. That extra density along the
+strokes (a curved line of normals) shifts the zero level Eq. 11 takes at the
+strokes, so between the strokes the surface moves towards the concave side: rough
+spheres shrink between their strokes by about a quarter of a cell, most of the
+Chamfer distance left on them. ``stroke_strip`` (off in every preset) splats the
+stroke samples in place of the surface samples near them instead: the spheres
+stay round, but the extra density is also what holds a surface on strokes where
+it folds (the open rims of vns/dress.obj) and without it the surface leaves them
+(``benchmarks/README.md``). ``polish`` (off in every preset) re-integrates the
+final f from more samples: closer to rough spheres, but off the strokes of that
+sketch too. ``paper`` keeps the published constants (no variant tried was better on
+every test shape). All presets solve the Poisson equation every ``poisson_every``
+steps and use the linearised data term in between (see :mod:`neural.flow`).
 ``benchmarks/README.md`` has the scores and timings of the presets and of the
 variants tried.
 
@@ -135,6 +143,12 @@ class FlowConfig:
     polish_smooth_cells : float
         Gaussian low-pass of that last solve, standard deviation in grid cells
         (the published code low-passes every solve by about one cell).
+    stroke_strip : float
+        Surface samples closer than this many grid cells to a stroke sample are
+        left out of the splat (full stage and ``polish``) and the stroke samples
+        carry their mass
+        (:func:`neural.poisson.stroke_strip`); 0 splats every sample with mass 1, as
+        the paper and the published code do.
     """
 
     res: int = 128
@@ -168,6 +182,7 @@ class FlowConfig:
     dtype: str = "float32"
     polish: int = 0
     polish_smooth_cells: float = 0.0
+    stroke_strip: float = 0.0
 
     def as_dict(self) -> dict:
         """The settings as a plain dict (for reports)."""
@@ -243,7 +258,7 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
         if not getattr(cfg, name) > 0:
             raise ValueError(f"{name} must be positive, got {getattr(cfg, name)!r}")
     for name in ("w_align", "w_smooth", "w_data", "w_eik", "w_curl", "w_normal", "grad_clip",
-                 "smooth_cells", "polish_smooth_cells"):
+                 "smooth_cells", "polish_smooth_cells", "stroke_strip"):
         if not getattr(cfg, name) >= 0:
             raise ValueError(f"{name} must be non-negative, got {getattr(cfg, name)!r}")
     if not 0.0 <= cfg.normalize_from <= 1.0:
