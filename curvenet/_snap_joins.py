@@ -14,7 +14,7 @@ import numpy as np
 from .core.geometry import cumulative_length, interpolate_polyline
 from .core.tolerances import DIVISION_GUARD
 
-__all__ = ["chord_turn", "dissolve"]
+__all__ = ["chord_turn", "dissolve", "join_turn"]
 
 
 def chord_turn(p0, p1, p2):
@@ -25,13 +25,26 @@ def chord_turn(p0, p1, p2):
     return np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", u, v) / (nu * nv), -1, 1)))
 
 
-def _tangent_at(curve, at_start, w):
-    """Unit direction leaving the curve's start (or end): towards the first point ``>= w`` away."""
-    c = curve if at_start else curve[::-1]
-    d = np.linalg.norm(c - c[0], axis=1)
-    far = np.flatnonzero(d >= w)
-    vec = c[far[0] if far.size else -1] - c[0]
-    return vec / max(np.linalg.norm(vec), DIVISION_GUARD)  # guard: degenerate curve
+def _far_point(c, w):
+    """The first point of polyline ``c`` at least ``w`` from ``c[0]``, else its last point."""
+    far = np.flatnonzero(np.linalg.norm(c - c[0], axis=1) >= w)
+    return c[far[0] if far.size else -1]
+
+
+def join_turn(c1, c2, w):
+    """Turn in degrees where curve ``c1`` ends and ``c2`` starts: ``t_w``, or the mean of
+    ``t_w`` and ``t_h`` where that is smaller.
+
+    ``t_w`` and ``t_h``: the turns between the chords ``w`` and ``w / 2`` long on each
+    side (to the first points that far from the join, or a side's far end where it is
+    shorter). A smooth join on a curve of curvature ``k`` turns by ``k w`` and ``k w /
+    2``: on a curve as tight as the window (a torus's small circle) the mean tells it
+    from a corner, which turns about as much at both lengths (a little less at ``w /
+    2`` where it was drawn rounded; the shorter chords alone would dissolve those).
+    """
+    t_w, t_h = (chord_turn(*(x[None] for x in (_far_point(c1[::-1], d), c2[0],
+                                                _far_point(c2, d))))[0] for d in (w, 0.5 * w))
+    return float(min(t_w, 0.5 * (t_w + t_h)))
 
 
 def _corner_near_join(curve, s_join, tol, opts):
@@ -97,9 +110,7 @@ def dissolve(edges, corner_ids, tol, opts, verts, report):
         u1 = e1[0] if e1[1] == v else e1[1]
         c2 = e2[2] if e2[0] == v else e2[2][::-1]  # starts at v
         w2 = e2[1] if e2[0] == v else e2[0]
-        turn = np.degrees(np.arccos(np.clip(-_tangent_at(c1, False, w) @ _tangent_at(c2, True, w),
-                                            -1, 1)))
-        if turn >= opts.corner_angle:
+        if join_turn(c1, c2, w) >= opts.corner_angle:
             continue
         label = "crease" if "crease" in (e1[4], e2[4]) else "boundary"
         joined = np.vstack([c1, c2[1:]])

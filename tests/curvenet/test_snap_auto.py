@@ -227,3 +227,39 @@ def test_short_stroke_over_a_ring_seam_is_overdraw(gap, over, first):
     assert (net.number_of_vertices, net.number_of_edges) == (1, 1)
     assert net.edges[0].u == net.edges[0].v
     assert abs(net.edges[0].length() / (2 * np.pi) - 1) < 0.01
+
+
+@pytest.mark.parametrize("radius,snap_tol", [(1.0, 0.055), (1.1, 0.06)])
+def test_smooth_join_on_a_tight_circle_is_dissolved(radius, snap_tol):
+    """A circle as tight as the corner window (its chords 1.5 tol long turn by about 50
+    degrees) drawn as two arcs with gaps of 0.7 tol at the top and bottom, crossed by two
+    lines: the gaps close smoothly, so the circle is two arcs between the two crossings
+    (the joins were kept as degree-2 corners: 8 vertices, 8 curves)."""
+    diag = np.sqrt(8 * radius**2 + 100)
+    d = 0.7 * snap_tol * diag / radius  # 0.7 tol of angle
+    arcs = [radius * _circle_arc(np.pi / 2 + d / 2, 3 * np.pi / 2 - d / 2, 90),
+            radius * _circle_arc(-np.pi / 2 + d / 2, np.pi / 2 - d / 2, 90)]
+    lines = [_line((x, 0.01, -5), (x, 0.01, 5), 200) for x in (-radius, radius)]
+    net = snap(Sketch(arcs + lines), snap_tol=snap_tol)
+    deg = np.bincount(net.endpoints.ravel(), minlength=net.number_of_vertices)
+    assert sorted(deg.tolist()) == [1, 1, 1, 1, 4, 4] and net.number_of_edges == 6
+    assert net.report["dissolved_joins"] == 2
+
+
+@pytest.mark.parametrize("angle", [70.0, 90.0])
+def test_corner_between_two_curved_strokes_stays(angle):
+    """Two strokes bending away from each other (curvature as tight as the window) that
+    meet at an ``angle``-degree corner across a gap of 0.5 tol: the corner stays a
+    vertex (the curvature is discounted, the corner is not)."""
+    tol = 0.055 * np.sqrt(8)
+    half = np.radians(angle) / 2
+    t = np.linspace(0, 1.0, 80)
+    # arcs of radius 1 leaving the corner at +-half from the x axis, curving outwards
+    a = np.stack([np.sin(t), 1 - np.cos(t), 0 * t], 1)
+    rot = [np.array([[np.cos(s), -np.sin(s), 0], [np.sin(s), np.cos(s), 0], [0, 0, 1]])
+           for s in (half, -half)]
+    s1 = (a * [1, 1, 0]) @ rot[0].T + [0.25 * tol * np.cos(half), 0.25 * tol * np.sin(half), 0]
+    s2 = (a * [1, -1, 0]) @ rot[1].T + [0.25 * tol * np.cos(half), -0.25 * tol * np.sin(half), 0]
+    net = snap(Sketch([s1[::-1], s2]), snap_tol=0.055)
+    assert (net.number_of_vertices, net.number_of_edges) == (3, 2)
+
