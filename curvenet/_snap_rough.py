@@ -8,17 +8,16 @@ from __future__ import annotations
 
 import numpy as np
 from scipy.ndimage import maximum_filter1d
-from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from ._snap_auto import check_density
 from ._snap_joins import chord_turn, dissolve
+from ._snap_merge import components, join_near
 from .core.geometry import arc_length, cumulative_length, interpolate_polyline
 from .core.tolerances import DIVISION_GUARD
 from .network import CurveNetwork
 
-__all__ = ["components", "first_items", "dedup", "snap_rough"]
+__all__ = ["dedup", "snap_rough"]
 
 #: Bound on the stroke samples of one snap: the sample spacing grows past tol / 4 to keep
 #: the total length / spacing under it.
@@ -400,8 +399,8 @@ def _cluster(samples, pos, mk, ms, tol, h):
     there. Per-stroke member list: sorted list of (s, junction id). Candidates within
     ``tol`` merge; so do junctions that land within ``1.5 tol`` of each other along
     one stroke (a corner whose pairwise contacts scattered), closest first, for up to
-    four rounds (see :func:`_join_near` for the pairs that do not merge). Junctions
-    are numbered by their first candidate.
+    four rounds (see :func:`curvenet._snap_merge.join_near` for the pairs that do not
+    merge). Junctions are numbered by their first candidate.
     """
     m = len(pos)
     if m == 0:
@@ -436,9 +435,12 @@ def _cluster(samples, pos, mk, ms, tol, h):
         near = (qk[1:] == qk[:-1]) & (qj[1:] != qj[:-1]) & (np.diff(qs) < 1.5 * tol)
         if not near.any():
             break
-        g = np.flatnonzero(pair)  # (junction, stroke) pairs, in order, and all gaps there?
-        ends = (j_o[g], k_o[g], np.logical_and.reduceat(gap[mc[order]], g))
-        joined = _join_near((np.diff(qs)[near], qk[1:][near], qj[:-1][near], qj[1:][near]),
+        g = np.flatnonzero(pair)  # (junction, stroke) pairs, in order: all gaps there? the
+        side = np.where(s_o <= 0.5 * h, 0, np.where(s_o >= L[k_o] - 0.5 * h, 1, 2))
+        lo_s, hi_s = np.minimum.reduceat(side, g), np.maximum.reduceat(side, g)
+        ends = (j_o[g], k_o[g], np.logical_and.reduceat(gap[mc[order]], g),
+                np.where(lo_s == hi_s, lo_s, 2))  # stroke end there: 0 start, 1 end, 2 other
+        joined = join_near((np.diff(qs)[near], qk[1:][near], qj[:-1][near], qj[1:][near]),
                             cid, gap, ends, held, L, tol)
         if len(joined) == 0:
             break
@@ -451,71 +453,6 @@ def _cluster(samples, pos, mk, ms, tol, h):
             continue
         out.append((s, jn))
     return J, per_stroke
-
-
-def _join_near(near, cid, gap, ends, held, L, tol):
-    """Candidate pairs ``(p, 2) int64`` that join the junctions of near pairs, closest first.
-
-    ``near``: per pair of junctions ``j1, j2`` within ``1.5 tol`` along stroke ``k``, arrays
-    ``(ds, k, j1, j2)``. ``cid (m,)``: junction of each candidate; ``gap (m,) bool``: the
-    candidate is two stroke ends; ``ends``: per (junction, stroke) pair with members, in
-    order, arrays ``(junction, stroke, only gap members)``. A split stroke (two stroke ends
-    meeting in a gap, nothing else) does not pull in a junction one piece passes through
-    once the gap has joined a junction some stroke passes through: a gap between two
-    nearby crossings would chain them into one. ``held`` (first candidate of a junction ->
-    such pieces) carries over rounds and is updated in place.
-    """
-    (ds, kk, j1, j2), (ej, ek, only) = near, ends
-    key = ej * len(L) + ek
-    split = (np.bincount(ej, minlength=cid.max() + 1) == 2) & (
-        np.bincount(ej, weights=~only, minlength=cid.max() + 1) == 0)
-    through = np.bincount(cid, weights=~gap) > 0  # some stroke passes through
-    fi = first_items(cid)
-    parent, out = {}, []
-
-    def find(j):
-        while parent.get(j, j) != j:
-            j = parent[j]
-        return j
-
-    def gap_only(j, k):
-        return only[np.searchsorted(key, j * len(L) + k)]
-
-    for x in np.lexsort((j2, j1, kk, ds)).tolist():
-        k, a, b = int(kk[x]), int(j1[x]), int(j2[x])
-        ra, rb = find(a), find(b)
-        ha, hb = held.get(fi[ra], set()), held.get(fi[rb], set())
-        if ra == rb or (k in ha and not gap_only(b, k)) or (k in hb and not gap_only(a, k)):
-            continue
-        new = ha | hb
-        for jx, ry in ((a, rb), (b, ra)):  # a split joins a junction some stroke passes through
-            if split[jx] and through[ry]:  # (a stroke under 2 tol is all ends)
-                lo = np.searchsorted(ej, jx)
-                new |= {int(y) for y in ek[lo:lo + 2] if y != k and L[y] > 2.0 * tol}
-        root = min(ra, rb)
-        parent[max(ra, rb)] = root
-        through[root] = through[ra] or through[rb]
-        held[fi[root]] = new
-        out.append((fi[a], fi[b]))
-    return np.array(out, dtype=np.int64).reshape(-1, 2)
-
-
-def first_items(comp):
-    """Smallest item ``(c,) int64`` of each of the components ``comp (m,)`` numbers."""
-    first = np.full(comp.max() + 1, len(comp), dtype=np.int64)
-    np.minimum.at(first, comp, np.arange(len(comp)))
-    return first
-
-
-def components(m, links):
-    """Connected components of ``m`` items joined by the pairs ``links (p, 2)``, numbered
-    in the order of their smallest item (as union-find with the smaller root winning)."""
-    graph = coo_matrix((np.ones(len(links)), (links[:, 0], links[:, 1])), shape=(m, m))
-    _, comp = connected_components(graph, directed=False)
-    _, first = np.unique(comp, return_index=True)
-    rank = np.empty(len(first), dtype=np.int64)
-    rank[np.argsort(first)] = np.arange(len(first))
-    return rank[comp]
 
 
 def _corners(samples, tol, h, opts):

@@ -73,7 +73,8 @@ from scipy.spatial import cKDTree
 
 from .core.tolerances import COINCIDENT_REL, DUPLICATE_POINT_REL, check_snap_tol
 from .errors import InvalidParameterError
-from ._snap_rough import components, dedup, first_items
+from ._snap_merge import components, first_items
+from ._snap_rough import dedup
 from .network import CurveNetwork, indexed_network
 from .sketch import Sketch
 

@@ -263,3 +263,23 @@ def test_corner_between_two_curved_strokes_stays(angle):
     net = snap(Sketch([s1[::-1], s2]), snap_tol=0.055)
     assert (net.number_of_vertices, net.number_of_edges) == (3, 2)
 
+
+@pytest.mark.parametrize("length", [1.1, 1.3])
+def test_short_piece_between_two_gaps_does_not_chain_two_crossings(length):
+    """A line drawn in three pieces across two crossings 2.8 tol apart: the middle piece
+    (``length`` tol) starts and ends in gaps next to the two crossings. Each gap closes
+    onto its crossing; the crossings stay two degree-4 vertices 2.8 tol apart (the
+    junctions at the short piece's two ends were merged along it into one degree-6
+    vertex)."""
+    tol = 0.025 * 2 * np.sqrt(2)
+    x2 = 2.8 * tol
+    a = 0.5 * (x2 - length * tol)  # the middle piece is centred between the crossings
+    sk = Sketch([_line((-1, 0, 0), (a - 0.45 * tol, 0, 0), 80),
+                 _line((a, 0, 0), (x2 - a, 0, 0), 12),
+                 _line((x2 - a + 0.45 * tol, 0, 0), (1, 0, 0), 80),
+                 _line((0, -1, 0.01), (0, 1, 0.01), 80), _line((x2, -1, 0.01), (x2, 1, 0.01), 80)])
+    net = snap(sk, snap_tol=0.025)
+    deg = np.bincount(net.endpoints.ravel(), minlength=net.number_of_vertices)
+    assert sorted(deg.tolist()) == [1] * 6 + [4, 4]
+    x = np.sort(net.positions[deg == 4][:, 0])
+    assert abs(x[0]) < 0.5 * tol and abs(x[1] - x2) < 0.5 * tol
