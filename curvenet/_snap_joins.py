@@ -90,8 +90,8 @@ def dissolve(edges, corner_ids, tol, opts, verts, report):
     join (:func:`_corner_near_join`), the vertex moves to that corner (``verts``
     is updated in place) instead of being dissolved.
 
-    Returns the new edge list; ``report["dissolved_joins"]`` is set and the moved
-    vertices are added to ``report["corners"]``.
+    Returns the new edge list; the dissolved vertices are added to
+    ``report["dissolved_joins"]`` and the moved ones to ``report["corners"]``.
     """
     count = moved = 0
     inc = [set() for _ in range(len(verts))]
@@ -131,7 +131,7 @@ def dissolve(edges, corner_ids, tol, opts, verts, report):
         inc[w2].add(i1)
         inc[u1].add(i1)
         count += 1
-    report["dissolved_joins"] = count
+    report["dissolved_joins"] += count
     report["corners"] += moved
     return [e for e in edges if e is not None]
 

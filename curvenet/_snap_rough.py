@@ -626,6 +626,8 @@ def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
             report["gap_merges"] += 1
     edges = dissolve(edges, corner_ids, tol, opts, verts, report)
     edges, report["slivers_merged"] = merge_slivers(edges, tol)
+    if report["slivers_merged"]:  # a junction of slivers may be left of degree 2
+        edges = dissolve(edges, corner_ids, tol, opts, verts, report)
     used = sorted({e[0] for e in edges} | {e[1] for e in edges})
     new_id = {v: i for i, v in enumerate(used)}
     net = CurveNetwork(np.array([verts[v] for v in used]).reshape(-1, 3))

@@ -30,7 +30,9 @@ Pipeline of :func:`snap` (``mode="rough"``)
    are within ``tol`` is closed. Candidates within ``tol`` of each other are
    merged (connected components) into one junction at their mean, and so are
    junctions within ``1.5 tol`` along one stroke, closest first; a gap (two
-   stroke ends) that has joined a junction does not pull in a second one.
+   stroke ends) that has joined a junction does not pull in a second one, nor
+   do two junctions that strokes pass through merge along a short stroke that
+   runs from one to the other.
 5. Corners: where a stroke turns by more than ``corner_angle`` between the
    chords ``tol * corner_window`` before and after a point (local maximum),
    and no junction is within ``tol``, it gets a degree-2 vertex.
@@ -42,11 +44,13 @@ Pipeline of :func:`snap` (``mode="rough"``)
    the last junction is an overshoot and is trimmed; longer ones stay as
    dangling edges (degree-1 vertices, listed in the report).
 7. Degree-2 vertices made only by stroke ends meeting smoothly (gap closing:
-   join angle below ``corner_angle``) are dissolved, unless the joined curve
+   join angle below ``corner_angle``; the turn over chords ``corner_window *
+   tol``, or its mean with the turn over half that where smaller, so that a join
+   on a curve as tight as the window is smooth) are dissolved, unless the joined curve
    turns sharply once within ``2 tol`` of the join (a corner the per-stroke
    search could not see, too close to a stroke end): the vertex moves there.
    Parallel edges between the same vertices closer than ``2 tol`` (left-over
-   overdraw) are averaged.
+   overdraw) are averaged; a junction left of degree 2 by that is dissolved as above.
 
 ``mode="exact"`` (chosen by ``mode="auto"`` when every stroke end coincides,
 to ``1e-9`` of the diagonal, with a point of another stroke or with its own

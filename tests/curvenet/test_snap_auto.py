@@ -283,3 +283,17 @@ def test_short_piece_between_two_gaps_does_not_chain_two_crossings(length):
     assert sorted(deg.tolist()) == [1] * 6 + [4, 4]
     x = np.sort(net.positions[deg == 4][:, 0])
     assert abs(x[0]) < 0.5 * tol and abs(x[1] - x2) < 0.5 * tol
+
+
+def test_junction_left_of_degree_two_by_a_sliver_merge_is_dissolved():
+    """A stroke drawn a second time over part of a line, bulging 1.5 tol off it (too
+    steep for overdraw, within the 2 tol of a sliver): its ends make two T-junctions on
+    the line, the two curves between them are averaged into one, and the junctions, left
+    of degree 2 with the line passing smoothly, are dissolved: one curve, not three."""
+    tol = 0.025 * 1.0
+    line = _line((0, 0, 0), (1, 0, 0), 200)
+    t = np.linspace(0, 1, 60)
+    bulge = np.stack([0.35 + 0.3 * t, 1.5 * tol * np.sin(np.pi * t), 0 * t], 1)
+    net = snap(Sketch([line, bulge]), snap_tol=0.025)
+    assert net.report["slivers_merged"] == 1
+    assert (net.number_of_vertices, net.number_of_edges) == (2, 1)
