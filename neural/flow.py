@@ -30,11 +30,11 @@ Engineering choices (documented deviations / gap fills)
   ``normalize_from`` of the full stage on: each node's sum is divided by
   ``max(weight sum, mean positive weight sum)``, which removes the density bias
   of the stroke samples without inflating sparsely hit nodes.
-* ``stroke_strip > 0`` (``default``: one cell): the surface samples within that
+* ``stroke_strip > 0`` (off in every preset): the surface samples within that
   many cells of a stroke sample are left out of the splat and the stroke
-  samples carry their mass, at least ``strip_floor`` each
-  (:func:`neural.poisson.stroke_strip`), so the splat has one density along
-  the surface; the paper splats the stroke samples on top of the surface ones.
+  samples carry their mass (:func:`neural.poisson.stroke_strip`),
+  so the splat has one density along the surface; the paper splats the stroke
+  samples on top of the surface ones.
 * ``geometric_init_steps > 0`` (draft, default) first fits g to the gradient
   ``sigma (x - c) / |x - c|`` of a sphere around the stroke centroid c (cheap:
   no derivatives), a geometric initialisation like the published code's
@@ -604,8 +604,7 @@ class _FlowFit:
         if x_u is None or self.cfg.stroke_strip <= 0:
             return None, None
         from .poisson import stroke_strip
-        return stroke_strip(x_s, x_u, self.cfg.stroke_strip / self.cfg.res,
-                            floor=self.cfg.strip_floor)
+        return stroke_strip(x_s, x_u, self.cfg.stroke_strip / self.cfg.res)
 
     def _surface_terms(self, vals, x_u, x_s, g_s):
         """Smoothness and Eikonal terms into ``vals``; the points, g and masses to splat."""

@@ -89,7 +89,7 @@ def splat(points: torch.Tensor, values: torch.Tensor, res: int, weights=None):
     return grid.t().reshape(C, res, res, res), wsum.reshape(res, res, res)
 
 
-def stroke_strip(x_s, x_u, width: float, *, floor: float = 0.0, chunk: int = 2048):
+def stroke_strip(x_s, x_u, width: float, *, chunk: int = 2048):
     """Surface samples off the strokes' strip, and the mass the stroke samples take over.
 
     The strokes lie on the surface, so splatting stroke samples beside the surface
@@ -99,10 +99,9 @@ def stroke_strip(x_s, x_u, width: float, *, floor: float = 0.0, chunk: int = 204
     between strokes moves towards the concave side (a rough sphere shrinks between
     its strokes). Dropping the surface samples closer than ``width`` to a stroke
     sample and giving the stroke samples their mass keeps one density along the
-    whole surface. Where few surface samples lie along the strokes (a sketch of
-    a few strokes that carry the whole surface, such as the rims of an open one)
-    that mass is a small fraction of a sample and the strokes' normals would all
-    but vanish from the splat, so a stroke sample never weighs less than ``floor``.
+    whole surface. Where the surface folds at a stroke (the rim of an open
+    surface) the extra density is also what holds it on the stroke, so the fits
+    leave this off (:mod:`neural.presets`).
 
     Parameters
     ----------
@@ -110,22 +109,19 @@ def stroke_strip(x_s, x_u, width: float, *, floor: float = 0.0, chunk: int = 204
     x_u : (n_u, 3) tensor, surface samples (same device and dtype)
     width : float
         Strip half-width, unit-cube units.
-    floor : float
-        Least mass of a stroke sample, as a fraction of a surface sample's.
     chunk : int
         Surface samples per distance block (bounds memory to ``chunk * n_s``).
 
     Returns
     -------
     keep : (n_u,) bool tensor, the surface samples outside the strip
-    mass : (n_s + kept,) tensor, the masses of the stroke samples, ``max(k / n_s, floor)``
-        each for the ``k`` surface samples dropped (1 when none is), then of the kept
-        ones (1)
+    mass : (n_s + kept,) tensor, the masses of the stroke samples, ``k / n_s`` each for
+        the ``k`` surface samples dropped (1 when none is), then of the kept ones (1)
     """
     near = torch.cat([torch.cdist(block, x_s).amin(1) < width for block in x_u.split(chunk)])
     k = int(near.sum())
     mass = x_s.new_ones(len(x_s) + len(x_u) - k)
-    mass[: len(x_s)] = max(k / len(x_s), floor) if k else 1.0
+    mass[: len(x_s)] = k / len(x_s) if k else 1.0
     return ~near, mass
 
 

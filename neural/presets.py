@@ -20,22 +20,20 @@ balances quality and time (128^3) and is the better choice on a GPU. Both raise 
 smoothness weight from the paper's 0.01 to 0.1 and start from a radial geometric
 initialisation: with their short budgets the paper's weight leaves mid-frequency
 bumps, and the plain SIREN initialisation starts from a rough field they cannot
-recover from. The paper and the published code splat the stroke samples on top
-of the surface samples. That extra density along the strokes (a curved line of
-normals) shifts the zero level Eq. 11 takes at the strokes, so between the
-strokes the surface moves towards the concave side: rough spheres shrink between
-their strokes by about a quarter of a cell, most of the Chamfer distance left on
-them. ``default`` therefore splats the stroke samples in place of the surface
-samples within one cell of them (``stroke_strip``), each with at least half a
-surface sample's mass (``strip_floor``): without that floor a sketch of a few
-strokes that carry the whole surface (the three rims of vns/dress.obj) lost the
-strokes' normals from the splat and the surface left them. ``draft`` and
-``paper`` splat as the paper does (``benchmarks/README.md``). ``polish`` (off in
-every preset) re-integrates the final f from more samples: closer to rough
-spheres, but off the strokes of vns/dress.obj too. ``paper`` keeps the published
-constants (no variant tried was better on every test shape). All presets solve
-the Poisson equation every ``poisson_every`` steps and use the linearised data
-term in between (see :mod:`neural.flow`).
+recover from. Every preset splats the stroke samples on top of the surface
+samples, as the paper and the published code do. That extra density along the
+strokes (a curved line of normals) shifts the zero level Eq. 11 takes at the
+strokes, so between the strokes the surface moves towards the concave side: rough
+spheres shrink between their strokes by about a quarter of a cell, most of the
+Chamfer distance left on them. ``stroke_strip`` (off in every preset) splats the
+stroke samples in place of the surface samples near them instead: the spheres
+stay round, but the extra density is also what holds a surface on strokes where
+it folds (the open rims of vns/dress.obj) and without it the surface leaves them
+(``benchmarks/README.md``). ``polish`` (off in every preset) re-integrates the
+final f from more samples: closer to rough spheres, but off the strokes of that
+sketch too. ``paper`` keeps the published constants (no variant tried was better on
+every test shape). All presets solve the Poisson equation every ``poisson_every``
+steps and use the linearised data term in between (see :mod:`neural.flow`).
 ``benchmarks/README.md`` has the scores and timings of the presets and of the
 variants tried.
 
@@ -151,10 +149,6 @@ class FlowConfig:
         carry their mass
         (:func:`neural.poisson.stroke_strip`); 0 splats every sample with mass 1, as
         the paper and the published code do.
-    strip_floor : float
-        Least mass of a stroke sample under ``stroke_strip``, as a fraction of a
-        surface sample's: where few surface samples lie along the strokes (a few
-        strokes carrying the whole surface) the strokes keep their normals.
     """
 
     res: int = 128
@@ -189,7 +183,6 @@ class FlowConfig:
     polish: int = 0
     polish_smooth_cells: float = 0.0
     stroke_strip: float = 0.0
-    strip_floor: float = 0.5
 
     def as_dict(self) -> dict:
         """The settings as a plain dict (for reports)."""
@@ -200,7 +193,7 @@ PRESETS: dict[str, FlowConfig] = {
     "draft": FlowConfig(res=64, width=64, hidden_layers=2, n_stroke=1200, n_surface=1000,
                         n_volume=600, init_steps=40, steps=100, lr=3e-4, poisson_every=1,
                         w_smooth=0.1),
-    "default": FlowConfig(w_smooth=0.1, stroke_strip=1.0),
+    "default": FlowConfig(w_smooth=0.1),
     "paper": FlowConfig(res=256, width=256, hidden_layers=4, n_stroke=10000, n_surface=15000,
                         n_volume=15000, init_steps=200, steps=800, lr=5e-5,
                         geometric_init_steps=0),
@@ -265,7 +258,7 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
         if not getattr(cfg, name) > 0:
             raise ValueError(f"{name} must be positive, got {getattr(cfg, name)!r}")
     for name in ("w_align", "w_smooth", "w_data", "w_eik", "w_curl", "w_normal", "grad_clip",
-                 "smooth_cells", "polish_smooth_cells", "stroke_strip", "strip_floor"):
+                 "smooth_cells", "polish_smooth_cells", "stroke_strip"):
         if not getattr(cfg, name) >= 0:
             raise ValueError(f"{name} must be non-negative, got {getattr(cfg, name)!r}")
     if not 0.0 <= cfg.normalize_from <= 1.0:
