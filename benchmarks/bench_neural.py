@@ -162,7 +162,7 @@ def main(argv=None):
     ap.add_argument("--timeout", type=float, default=3600,
                     help="seconds per rough sphere of the spheres section (loaded machines: more)")
     ap.add_argument("--set", nargs="*", default=[], metavar="NAME=VALUE",
-                    help="FlowConfig overrides of the spheres section")
+                    help="FlowConfig overrides of the spheres and vns sections")
     ap.add_argument("--vns-quality", default="draft", help="preset of the vns section")
     ap.add_argument("--png-dir", default="/tmp", help="where the vns previews go")
     ap.add_argument("--worker", help=argparse.SUPPRESS)
@@ -224,6 +224,7 @@ def main(argv=None):
         for name in names:
             path = vns / f"{name}.obj"
             r = _run({**base, "kind": "sketch", "path": str(path), "quality": a.vns_quality,
+                      "overrides": overrides,
                       "png": str(png / f"neural_{Path(name).name}.png")})
             _row("vns", a.vns_quality, name, f"strokes={r.get('strokes')}",
                  f"time={r.get('time_s', float('nan')):.1f}s",
