@@ -24,8 +24,8 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from .core.geometry import (arc_length, cumulative_length, densify_polyline, face_normals_areas,
-                            interpolate_polyline, sample_surface)
+from .core.geometry import (arc_length, boundary_edges, cumulative_length, densify_polyline,
+                            face_normals_areas, interpolate_polyline, sample_surface)
 from .evaluate import FIDELITY_TOL_REL, STROKE_SPACING_REL, point_surface_distance, stroke_samples
 
 __all__ = ["REGION_GAP", "plan_regions", "region_strokes", "patch_anchors", "trim_fill",
@@ -284,13 +284,6 @@ def trim_fill(vertices, faces, region_curves, patch_vertices, patch_faces, *,
     return near
 
 
-def _rim(faces) -> np.ndarray:
-    """(E, 2) vertex ids of the edges used by one face (the boundary of a mesh)."""
-    edges = np.sort(np.asarray(faces)[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
-    edges, count = np.unique(edges, axis=0, return_counts=True)
-    return edges[count == 1]
-
-
 def close_seam(vertices, faces, patch_vertices, patch_faces, *, reach: float):
     """The fill with its boundary vertices near the patches moved onto them.
 
@@ -313,7 +306,7 @@ def close_seam(vertices, faces, patch_vertices, patch_faces, *, reach: float):
         The longest move (0 when none).
     """
     vertices = np.array(vertices, dtype=np.float64)
-    ids = np.unique(_rim(faces))
+    ids = np.unique(boundary_edges(faces))
     if not len(ids) or not len(patch_faces):
         return vertices, 0.0
     d, _, closest = point_surface_distance(vertices[ids], patch_vertices, patch_faces,
@@ -353,7 +346,7 @@ def fill_seam(vertices, faces, shared_curves, *, gap: float, tol: float) -> dict
         return none
     q = _dense(shared_curves, tol / 2)
     q = q[point_surface_distance(q, vertices, faces)[0] < gap / 2]
-    rim = _rim(faces)
+    rim = boundary_edges(faces)
     if not len(q) or not len(rim):
         return none
     ends = np.asarray(vertices, np.float64)[rim]                        # (E, 2, 3)

@@ -28,6 +28,7 @@ import numpy as np
 import torch
 from torch import nn
 
+from curvenet.core.geometry import boundary_edges
 from curvenet.core.tolerances import NORM_EPS
 
 from .feature import feature_function, mollified_feature_function
@@ -130,10 +131,7 @@ def boundary_triples(triangles) -> np.ndarray:
 
     Sec. 5.2: for a 3D feature surface ``L_R`` is imposed on its boundary curves dM.
     """
-    t = np.asarray(triangles, dtype=np.int64).reshape(-1, 3)
-    e = np.sort(np.concatenate([t[:, [0, 1]], t[:, [1, 2]], t[:, [2, 0]]]), axis=1)
-    uniq, counts = np.unique(e, axis=0, return_counts=True)
-    return polyline_triples(uniq[counts == 1])
+    return polyline_triples(boundary_edges(triangles))
 
 
 def smoothness_regulariser(vertices: torch.Tensor, triples, lam: float = LR_LAMBDA

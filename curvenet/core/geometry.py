@@ -1,8 +1,8 @@
 """Geometric primitives shared by the graph code and both backends.
 
 Polylines: validation, arc length, interpolation at arc-length parameters,
-resampling; triangle meshes: face normals and areas, area-uniform random
-sampling (trimesh's :func:`trimesh.sample.sample_surface`). Everything takes
+resampling; triangle meshes: face normals and areas, boundary edges, area-uniform
+random sampling (trimesh's :func:`trimesh.sample.sample_surface`). Everything takes
 and returns numpy arrays; nothing here imports torch or another curvenet module
 (the neural backend converts the samples to tensors itself).
 
@@ -31,6 +31,7 @@ __all__ = [
     "resample_polyline",
     "densify_polyline",
     "face_normals_areas",
+    "boundary_edges",
     "sample_surface",
     "fit_plane",
 ]
@@ -272,6 +273,29 @@ def face_normals_areas(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndar
     norm = np.linalg.norm(cross, axis=1)
     normals = cross / np.maximum(norm, DIVISION_GUARD)[:, None]           # zero area
     return normals, 0.5 * norm
+
+
+def boundary_edges(faces: np.ndarray) -> np.ndarray:
+    """Edges used by exactly one triangle (the boundary of a mesh).
+
+    Parameters
+    ----------
+    faces : (F, 3) int
+
+    Returns
+    -------
+    (E, 2) int64
+        Vertex ids, the smaller first in each row, rows in lexicographic order.
+
+    Examples
+    --------
+    >>> boundary_edges(np.array([[0, 1, 2], [2, 1, 3]])).tolist()
+    [[0, 1], [0, 2], [1, 3], [2, 3]]
+    """
+    f = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    edges = np.sort(f[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+    edges, count = np.unique(edges, axis=0, return_counts=True)
+    return edges[count == 1]
 
 
 def sample_surface(vertices: np.ndarray, faces: np.ndarray, n: int, seed=None, *,

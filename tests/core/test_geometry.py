@@ -9,8 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from curvenet.core import (LABELS, arc_length, arc_length_params, as_polyline, check_labels,
-                           check_strokes, cumulative_length, densify_polyline,
+from curvenet.core import (LABELS, arc_length, arc_length_params, as_polyline, boundary_edges,
+                           check_labels, check_strokes, cumulative_length, densify_polyline,
                            face_normals_areas, interpolate_polyline, resample_polyline,
                            sample_at, sample_surface)
 from curvenet.core.tolerances import SNAP_TOL_RANGE, check_snap_tol
@@ -101,6 +101,18 @@ def test_densify_keeps_vertices_and_bounds_the_step():
 
 
 # --------------------------------------------------------------------------- triangles
+def test_boundary_edges_of_a_closed_mesh_are_none_and_of_a_cut_one_its_rim():
+    import trimesh
+    m = trimesh.creation.icosphere(2)
+    assert boundary_edges(m.faces).shape == (0, 2)
+    cut = m.faces[m.triangles_center[:, 2] > 0.0]          # the upper half: one rim loop
+    rim = boundary_edges(cut)
+    assert bool((rim[:, 0] < rim[:, 1]).all())
+    deg = np.bincount(rim.ravel())
+    assert set(deg[deg > 0].tolist()) == {2}                  # every rim vertex on two edges
+    assert len(rim) == len(np.unique(rim))                    # a single loop: E = V
+
+
 def test_face_normals_areas_hand_case():
     v = np.array([[0, 0, 0], [2, 0, 0], [0, 3, 0], [1, 1, 1.0]])
     n, a = face_normals_areas(v, np.array([[0, 1, 2], [0, 2, 1], [0, 0, 3]]))
