@@ -60,9 +60,13 @@ Engineering choices (documented deviations / gap fills)
   cylinder is a capsule, and box faces bulge into pillows
   (``benchmarks/bench_flow_limits.py`` measures both; the figures, and the
   terms tried against it, are in ``benchmarks/README.md``).
-* ``polish = k > 0`` re-integrates the final f from k times the stroke and
-  surface samples of one step with the trained network (forward passes only):
-  the same field in expectation, with less Monte-Carlo noise in the splat.
+* ``polish = k > 0`` re-integrates the final f (forward passes only) from k times
+  the stroke and surface samples of one step, ``polish_rounds`` times, optionally
+  with the stroke strip (``polish_strip``) and a low-pass: less Monte-Carlo noise in
+  the splat and, with the strip, no shrinking between smooth strokes. The polished
+  surface is returned only when its stroke fidelity is at least the last step's
+  (:func:`_polished`): on sketches whose surface the strokes' extra density holds
+  in place (open rims), the re-integration moves it off them.
 * Final mesh: pieces of the zero set with no stroke within 4 grid cells are
   dropped (spurious level-set components of the periodic f).
 * ``anchors`` (not in the paper): oriented points of another surface the fit must
@@ -433,12 +437,13 @@ class _FlowFit:
             full = Stage("full", cfg.steps, self._flow_step("full", cfg.steps))
         return [first, full]
 
-    def solve(self, points, values, normalize, need_adjoint, n_stroke=None, mass=None):
+    def solve(self, points, values, normalize, need_adjoint, n_stroke=None, mass=None,
+              solver=None):
         """Splat -> FFT Poisson -> Eq. 11; returns (f_grid, data loss, raw grid).
 
         The first ``n_stroke`` (default ``cfg.n_stroke``) points are the data samples
         (the stroke samples, then the anchors'); ``mass`` (optional, (M,)) weighs the
-        points in the splat.
+        points in the splat; ``solver`` (default the fit's) solves.
         """
         from .losses import data_loss
         from .poisson import interpolate, normalize_scale_shift, normalize_splat, splat
@@ -448,37 +453,42 @@ class _FlowFit:
             raw.retain_grad()
         if normalize:
             grid = normalize_splat(grid, wsum)
-        f = self.solver.solve(grid)
+        f = (solver or self.solver).solve(grid)
         f_s = interpolate(f, points[: n_stroke or self.cfg.n_stroke])
         f, f_s = normalize_scale_shift(f, f_s)
         return f, data_loss(f_s), raw
 
-    def polish(self, f, factor: int):
-        """f re-integrated from ``factor`` times the samples of one step, without gradients.
+    def polish(self, f):
+        """f re-integrated ``cfg.polish_rounds`` times with the trained g, without gradients.
 
-        The stroke and surface samples of a step are drawn ``factor`` times over (the
-        surface ones on the zero set of ``f``), in the same proportion, and splatted
-        with the normalisation of the last step: the same field in expectation as one
-        step's solve, with the Monte-Carlo noise of the splat down by about
-        ``sqrt(factor)``. The solve low-passes by ``cfg.polish_smooth_cells``.
+        Each round draws ``cfg.polish`` times the stroke and surface samples of a step
+        (the surface ones on the zero set of the round before), in the same proportion,
+        and splats them with the normalisation of the last step, leaving out the surface
+        samples within ``cfg.polish_strip`` cells of the strokes; the solve low-passes by
+        ``cfg.polish_smooth_cells``. The Monte-Carlo noise of the splat is down by about
+        ``sqrt(cfg.polish)``; the per-node normalisation sees ``cfg.polish`` times the
+        weight, so even one round without strip or low-pass is not quite a step's
+        field (``benchmarks/README.md``).
         """
         import torch
+
+        from .poisson import PoissonSolver
         cfg = self.cfg
+        normalize = cfg.steps - 1 >= int(cfg.normalize_from * cfg.steps)   # as the last step
+        solver = PoissonSolver(cfg.res, device=self.dev, dtype=self.dtype,
+                               smooth_cells=cfg.polish_smooth_cells, boundary=cfg.boundary)
         with torch.no_grad():
-            x_s = self._data_points(factor)
-            x_u = sample_surface_cells(f, factor * cfg.n_surface, self.gen)
-            keep, mass = self._strip(x_s, x_u)
-            if keep is not None:
-                x_u = x_u[keep]
-            pts = x_s if x_u is None else torch.cat([x_s, x_u])
-            vals = torch.cat([self.net(p) for p in pts.split(65536)])
-            normalize = cfg.steps - 1 >= int(cfg.normalize_from * cfg.steps)   # as the last step
-            if cfg.polish_smooth_cells != cfg.smooth_cells:
-                from .poisson import PoissonSolver
-                self.solver = PoissonSolver(cfg.res, device=self.dev, dtype=self.dtype,
-                                            smooth_cells=cfg.polish_smooth_cells,
-                                            boundary=cfg.boundary)
-            return self.solve(pts, vals, normalize, False, n_stroke=len(x_s), mass=mass)[0]
+            for _ in range(cfg.polish_rounds):
+                x_s = self._data_points(cfg.polish)
+                x_u = sample_surface_cells(f, cfg.polish * cfg.n_surface, self.gen)
+                keep, mass = self._strip(x_s, x_u, cfg.polish_strip)
+                if keep is not None:
+                    x_u = x_u[keep]
+                pts = x_s if x_u is None else torch.cat([x_s, x_u])
+                vals = torch.cat([self.net(p) for p in pts.split(65536)])
+                f = self.solve(pts, vals, normalize, False, n_stroke=len(x_s), mass=mass,
+                               solver=solver)[0]
+        return f
 
     def solve_strokes_only(self, mesh_points=None):
         """f integrated from g at stroke samples (and ``mesh_points``), without gradients."""
@@ -598,13 +608,13 @@ class _FlowFit:
 
         return step
 
-    def _strip(self, x_s, x_u):
-        """``(keep, mass)`` of :func:`neural.poisson.stroke_strip` (``cfg.stroke_strip``
-        cells); ``(None, None)``, all splatted with mass 1, without x_u or strip."""
-        if x_u is None or self.cfg.stroke_strip <= 0:
+    def _strip(self, x_s, x_u, cells):
+        """``(keep, mass)`` of :func:`neural.poisson.stroke_strip` (``cells`` wide);
+        ``(None, None)``, all splatted with mass 1, without x_u or strip."""
+        if x_u is None or cells <= 0:
             return None, None
         from .poisson import stroke_strip
-        return stroke_strip(x_s, x_u, self.cfg.stroke_strip / self.cfg.res)
+        return stroke_strip(x_s, x_u, cells / self.cfg.res)
 
     def _surface_terms(self, vals, x_u, x_s, g_s):
         """Smoothness and Eikonal terms into ``vals``; the points, g and masses to splat."""
@@ -623,7 +633,7 @@ class _FlowFit:
             if cfg.w_smooth > 0:
                 vals["smooth"] = smoothness_loss_autograd(net, x_u)
         vals["eik"] = eikonal_loss(torch.cat([g_u, g_s]), cfg.sigma)
-        keep, mass = self._strip(x_s, x_u)
+        keep, mass = self._strip(x_s, x_u, cfg.stroke_strip)
         if keep is not None:
             x_u, g_u = x_u[keep], g_u[keep]
         return torch.cat([x_s, x_u]), torch.cat([g_s, g_u]), mass
@@ -657,18 +667,49 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
 
     t0 = time.perf_counter()
     f_final = run.best if run.best is not None else fit.solve_strokes_only()
+    mesh = _extract(f_final, fit.frame, strokes, labels, cut_boundary)
+    polish = None
     if cfg.polish > 0 and not interrupted:
-        f_final = fit.polish(f_final, cfg.polish)
-    V, F, f_np, origin, h_world, n_cut = _extract(f_final, fit.frame, strokes, labels,
-                                                  cut_boundary)
+        mesh, polish = _polished(fit, f_final, mesh, strokes, labels, cut_boundary)
+    V, F, f_np, origin, h_world, n_cut = mesh
     timings["extract"] = time.perf_counter() - t0
     timings["total"] = time.perf_counter() - t_start
     report = {"steps": steps_done, "interrupted": interrupted, "device": str(dev), "seed": seed,
               "quality": quality, "config": cfg.as_dict(), "n_vertices": len(V),
               "n_faces": len(F), "cut_faces": n_cut,
               "stroke_length_unit": fit.sampler.total_length}
+    if polish is not None:
+        report["polish"] = polish
     return FlowResult(V, F, report, f_grid=f_np, origin=origin, spacing=h_world, timings=timings,
                       history=fit.history)
+
+
+def _polished(fit: _FlowFit, f, mesh, strokes, labels, cut_boundary):
+    """The polished surface (:meth:`_FlowFit.polish`) if it holds as much of the strokes.
+
+    ``mesh`` is :func:`_extract`'s tuple for the last step's ``f``. The re-integration
+    removes Monte-Carlo noise and, with the strip, the shrinking of the surface between
+    smooth strokes; where the strokes' extra density is what holds the surface on them
+    (open rims, sparse sketches) it moves the surface off them instead. So the polished
+    surface is kept only when its stroke fidelity
+    (:func:`curvenet.evaluate.sketch_fidelity`) is at least that of ``mesh``.
+
+    Returns ``(mesh, {"fidelity": [last step's, polished], "kept": bool})``.
+    """
+    polished = _extract(fit.polish(f), fit.frame, strokes, labels, cut_boundary)
+    fidelity = [_fidelity(m[0], m[1], strokes) for m in (mesh, polished)]
+    kept = fidelity[1] >= fidelity[0]
+    return (polished if kept else mesh), {"fidelity": fidelity, "kept": kept}
+
+
+def _fidelity(V, F, strokes) -> float:
+    """Stroke fidelity of the mesh ``(V, F)`` (0 when it has no triangle of positive area)."""
+    from curvenet.errors import InvalidParameterError
+    from curvenet.evaluate import sketch_fidelity
+    try:
+        return sketch_fidelity((V, F), strokes)["surface"]
+    except InvalidParameterError:          # no faces, or only degenerate ones
+        return 0.0
 
 
 def _extract(f_final, frame: Frame, strokes, labels, cut_boundary):

@@ -109,6 +109,39 @@ def test_polish_keeps_the_surface_of_the_field():
     assert abs(radius.mean() - 1.0) < 0.02 and radius.std() < 0.01, (radius.mean(), radius.std())
 
 
+def _sphere_f(frame, res, radius):
+    """Unit-cube node grid (res^3, float32 tensor) of |x| - radius in ``frame``'s world."""
+    import torch
+    u = (np.arange(res) + 0.5) / res
+    world = frame.to_world(np.stack(np.meshgrid(u, u, u, indexing="ij"), -1).reshape(-1, 3))
+    return torch.as_tensor((np.linalg.norm(world, axis=1) - radius).reshape(res, res, res),
+                           dtype=torch.float32)
+
+
+@pytest.mark.parametrize("last, polished, kept", [(1.0, 0.8, False), (0.8, 1.0, True),
+                                                   (1.0, 1.0, True)])
+def test_polish_is_kept_only_when_it_holds_the_strokes(last, polished, kept):
+    # the strokes lie on the unit sphere: a polished f whose zero set is the sphere of
+    # radius 0.8 is off them and the last step's surface is returned; the other way round
+    # (and on a tie) the polished one
+    class Fit:
+        frame = flow.Frame.from_points(np.vstack(_circles()), 0.2)
+
+        def polish(self, f):
+            return _sphere_f(self.frame, 48, polished)
+
+    fit, strokes = Fit(), _circles()
+    labels = ["crease"] * 3
+    mesh = flow._extract(_sphere_f(fit.frame, 48, last), fit.frame, strokes, labels, True)
+    (V, _F, *_), info = flow._polished(fit, None, mesh, strokes, labels, True)
+    assert info["kept"] is kept
+    on, off = (0, 1) if last == 1.0 else (1, 0)
+    assert info["fidelity"][on] == 1.0
+    assert info["fidelity"][off] == 1.0 if last == polished else info["fidelity"][off] < 0.01
+    r = np.linalg.norm(V, axis=1)
+    assert abs(r.mean() - (polished if kept else last)) < 0.01
+
+
 def test_dirichlet_boundary_keeps_walls_outside():
     r = fit_flow_surface(_circles(), progress=False, boundary="dirichlet", **TINY)
     f = r.f_grid
@@ -249,6 +282,6 @@ def test_stroke_strip_in_the_fit_keeps_the_sphere():
     m = trimesh.creation.icosphere(3, radius=1.0)
     r = fit_flow_surface(_circles(), progress=False, init_mesh=(m.vertices, m.faces),
                          quality="draft", res=48, prefit_steps=150, steps=2, normalize_from=0.0,
-                         stroke_strip=1.0, polish=8)
+                         stroke_strip=1.0, polish=8, polish_strip=1.0)
     radius = np.linalg.norm(r.vertices, axis=1)
     assert abs(radius.mean() - 1.0) < 0.02 and radius.std() < 0.015, (radius.mean(), radius.std())
