@@ -89,7 +89,7 @@ def splat(points: torch.Tensor, values: torch.Tensor, res: int, weights=None):
     return grid.t().reshape(C, res, res, res), wsum.reshape(res, res, res)
 
 
-def stroke_strip(x_s, x_u, width: float, *, chunk: int = 2048):
+def stroke_strip(x_s, x_u, width: float):
     """Surface samples off the strokes' strip, and the mass the stroke samples take over.
 
     The strokes lie on the surface, so splatting stroke samples beside the surface
@@ -101,7 +101,7 @@ def stroke_strip(x_s, x_u, width: float, *, chunk: int = 2048):
     sample and giving the stroke samples their mass keeps one density along the
     whole surface. Where the surface folds at a stroke (the rim of an open
     surface) the extra density is also what holds it on the stroke, so the fits
-    leave this off (:mod:`neural.presets`).
+    train without it and use it only in their guarded polish (:mod:`neural.presets`).
 
     Parameters
     ----------
@@ -109,8 +109,6 @@ def stroke_strip(x_s, x_u, width: float, *, chunk: int = 2048):
     x_u : (n_u, 3) tensor, surface samples (same device and dtype)
     width : float
         Strip half-width, unit-cube units.
-    chunk : int
-        Surface samples per distance block (bounds memory to ``chunk * n_s``).
 
     Returns
     -------
@@ -118,7 +116,10 @@ def stroke_strip(x_s, x_u, width: float, *, chunk: int = 2048):
     mass : (n_s + kept,) tensor, the masses of the stroke samples, ``k / n_s`` each for
         the ``k`` surface samples dropped (1 when none is), then of the kept ones (1)
     """
-    near = torch.cat([torch.cdist(block, x_s).amin(1) < width for block in x_u.split(chunk)])
+    from scipy.spatial import cKDTree
+    d, _ = cKDTree(x_s.detach().cpu().double().numpy()).query(
+        x_u.detach().cpu().double().numpy(), distance_upper_bound=width)
+    near = torch.as_tensor(d < width, device=x_u.device)
     k = int(near.sum())
     mass = x_s.new_ones(len(x_s) + len(x_u) - k)
     mass[: len(x_s)] = k / len(x_s) if k else 1.0

@@ -226,7 +226,7 @@ def test_stroke_strip_hands_the_surface_along_the_strokes_to_them():
     x_s = torch.rand(500, 3, generator=gen, dtype=torch.float64)
     x_s[:, 1:] = 0.5
     width = 0.05
-    keep, mass = stroke_strip(x_s, x_u, width, chunk=700)
+    keep, mass = stroke_strip(x_s, x_u, width)
     d = torch.cdist(x_u, x_s).amin(1)
     assert bool((d[keep] >= width).all()) and bool((d[~keep] < width).all())
     k = int((~keep).sum())
