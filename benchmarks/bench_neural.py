@@ -85,7 +85,7 @@ def _worker(spec: dict) -> dict:
     out["timings"] = r.timings
     out["steps"] = r.report["steps"]
     out["faces"] = len(r.faces)
-    out["finish"] = _finish_column(r.report.get("finish"))
+    out["polish"] = _polish_column(r.report.get("polish"))
     out["cpu_s"] = time.process_time() - cpu
     out["peak_gb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e6
     if device.startswith("cuda"):
@@ -103,14 +103,12 @@ def _worker(spec: dict) -> dict:
     return out
 
 
-def _finish_column(info) -> str:
-    """The finish's choice: stroke fidelity of the full stage and of the finished surface."""
+def _polish_column(info) -> str:
+    """The polish's choice: stroke fidelity of the last step and of the polished surface."""
     if info is None:
-        return "finish=off"
-    if "fidelity" not in info:
-        return "finish=interrupted"
-    last, finished = info["fidelity"]
-    return f"finish={'kept' if info['kept'] else 'dropped'} ({last:.3f}->{finished:.3f})"
+        return "polish=off"
+    last, polished = info["fidelity"]
+    return f"polish={'kept' if info['kept'] else 'dropped'} ({last:.3f}->{polished:.3f})"
 
 
 def _render(V, F, strokes, path):
@@ -217,7 +215,7 @@ def main(argv=None):
                  _memory(r), f"{r['fscore']:.3f}", f"{r['chamfer']:.2e}")
     if "spheres" in a.only:
         _row("spheres", "quality", "sketch seed", "F-score@0.01", "Chamfer", "wall", "CPU",
-             "peak RSS", "finish (stroke fidelity)")
+             "peak RSS", "polish (stroke fidelity)")
         for seed in a.seeds:
             r = _run({**base, "kind": "sphere", "quality": a.reference_quality,
                       "sketch_seed": seed, "overrides": overrides}, timeout=a.timeout)
@@ -226,7 +224,7 @@ def main(argv=None):
                 continue
             _row("spheres", a.reference_quality, seed, f"{r['fscore']:.4f}",
                  f"{r['chamfer']:.2e}", f"{r['time_s']:.1f}s", f"{r['cpu_s']:.1f}s",
-                 _memory(r), r["finish"])
+                 _memory(r), r["polish"])
     if "vns" in a.only:
         names = a.vns
         if names == ["all"]:
@@ -241,7 +239,7 @@ def main(argv=None):
                  f"time={r.get('time_s', float('nan')):.1f}s",
                  f"cpu={r.get('cpu_s', float('nan')):.1f}s", f"faces={r.get('faces')}",
                  f"fidelity={r.get('fidelity', float('nan')):.3f}", _memory(r),
-                 r.get("finish", ""), r.get("error", ""))
+                 r.get("polish", ""), r.get("error", ""))
     print(f"# load average at end: {os.getloadavg()}")
 
 

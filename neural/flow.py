@@ -60,16 +60,13 @@ Engineering choices (documented deviations / gap fills)
   cylinder is a capsule, and box faces bulge into pillows
   (``benchmarks/bench_flow_limits.py`` measures both; the figures, and the
   terms tried against it, are in ``benchmarks/README.md``).
-* ``finish_steps = k > 0`` (``default``: 20) runs k more full steps after the
-  full stage, with the stroke strip (``finish_strip``) and a fresh Adam: the
-  paper's splat (stroke samples on top of the surface samples) shrinks a smooth
-  surface between its strokes, and the trained g follows the shrunken surface;
-  the finish turns it back. ``polish = k > 0`` then re-integrates f (forward
-  passes only) from k times a step's samples, ``polish_rounds`` times, optionally
-  with the strip (``polish_strip``) and a low-pass. The finished surface is
-  returned only when its stroke fidelity is at least the full stage's
-  (:func:`_finished`): on sketches whose surface the strokes' extra density holds
-  in place (open rims, sparse strokes), the strip moves it off them.
+* ``polish = k > 0`` re-integrates the final f (forward passes only) from k times
+  the stroke and surface samples of one step, ``polish_rounds`` times, optionally
+  with the stroke strip (``polish_strip``) and a low-pass: less Monte-Carlo noise in
+  the splat and, with the strip, no shrinking between smooth strokes. The polished
+  surface is returned only when its stroke fidelity is at least the last step's
+  (:func:`_polished`): on sketches whose surface the strokes' extra density holds
+  in place (open rims), the re-integration moves it off them.
 * Final mesh: pieces of the zero set with no stroke within 4 grid cells are
   dropped (spurious level-set components of the periodic f).
 * ``anchors`` (not in the paper): oriented points of another surface the fit must
@@ -410,8 +407,7 @@ class _FlowFit:
             self.prefit = (torch.as_tensor(P, device=dev, dtype=self.dtype),
                            torch.as_tensor(target, device=dev, dtype=self.dtype), mesh_surf)
         names = ("prefit",) if init_mesh is not None else ("init",)
-        names += ("full",) + (("finish",) if cfg.finish_steps > 0 else ())
-        self.history = {name: {t: [] for t in _TERMS} for name in names}
+        self.history = {name: {t: [] for t in _TERMS} for name in names + ("full",)}
 
     def geometric_stage(self) -> Stage:
         """Fit g to ``sigma (x - c) / |x - c|`` (c: stroke centroid); see the module notes."""
@@ -440,12 +436,6 @@ class _FlowFit:
             first = Stage("init", cfg.init_steps, self._flow_step("init", cfg.init_steps))
             full = Stage("full", cfg.steps, self._flow_step("full", cfg.steps))
         return [first, full]
-
-    def finish_stage(self) -> Stage:
-        """``cfg.finish_steps`` more full steps, normalised, with ``cfg.finish_strip``."""
-        cfg = self.cfg
-        return Stage("finish", cfg.finish_steps,
-                     self._flow_step("finish", cfg.finish_steps, strip=cfg.finish_strip))
 
     def solve(self, points, values, normalize, need_adjoint, n_stroke=None, mass=None,
               solver=None):
@@ -563,20 +553,14 @@ class _FlowFit:
         row = self._row({"total": loss})
         return Step(loss, dict(zip(_TERMS, row)), after=lambda: self._record("prefit", k, row))
 
-    def _flow_step(self, stage, n_steps, strip=None):
-        """Step function of the initialisation (strokes only), full or finish stage (Eq. 13).
-
-        ``strip`` (cells) replaces ``cfg.stroke_strip``; the finish stage splats
-        normalised from its first step.
-        """
+    def _flow_step(self, stage, n_steps):
+        """Step function of the initialisation (strokes only) or full stage (Eq. 13)."""
         import torch
 
         from .losses import alignment_loss, curl_loss
         from .poisson import splat
         cfg, net, gen = self.cfg, self.net, self.gen
-        full = stage != "init"
-        strip = cfg.stroke_strip if strip is None else strip
-        normalize_from = 0 if stage == "finish" else int(cfg.normalize_from * n_steps)
+        full = stage == "full"
 
         def step(k):
             x_s, t_s = self.sampler.sample(cfg.n_stroke, gen)
@@ -586,12 +570,12 @@ class _FlowFit:
             x_u = self._surface_samples(cfg.n_surface) if full else None
             vals = {"align": alignment_loss(g_s, G_s, t_s), "curl": curl_loss(G_sv[cfg.n_stroke:])}
             x_s, g_s = self._anchor_terms(vals, x_s, g_s)
-            pts, gv, mass = self._surface_terms(vals, x_u, x_s, g_s, strip)
+            pts, gv, mass = self._surface_terms(vals, x_u, x_s, g_s)
             if cfg.splat_volume:
                 pts, gv = torch.cat([pts, x_v]), torch.cat([gv, g_sv[cfg.n_stroke:]])
                 if mass is not None:
                     mass = torch.cat([mass, mass.new_ones(len(x_v))])
-            normalize = full and k >= normalize_from
+            normalize = full and k >= int(cfg.normalize_from * n_steps)
             do_solve = (k % cfg.poisson_every == 0) or k == n_steps - 1 or self.lam is None
             if do_solve:
                 f, vals["data"], raw = self.solve(pts, gv, normalize, cfg.poisson_every > 1,
@@ -632,9 +616,8 @@ class _FlowFit:
         from .poisson import stroke_strip
         return stroke_strip(x_s, x_u, cells / self.cfg.res)
 
-    def _surface_terms(self, vals, x_u, x_s, g_s, strip):
-        """Smoothness and Eikonal terms into ``vals``; the points, g and masses to splat
-        (the surface samples within ``strip`` cells of a stroke sample left out)."""
+    def _surface_terms(self, vals, x_u, x_s, g_s):
+        """Smoothness and Eikonal terms into ``vals``; the points, g and masses to splat."""
         import torch
 
         from .losses import eikonal_loss, smoothness_loss, smoothness_loss_autograd
@@ -650,7 +633,7 @@ class _FlowFit:
             if cfg.w_smooth > 0:
                 vals["smooth"] = smoothness_loss_autograd(net, x_u)
         vals["eik"] = eikonal_loss(torch.cat([g_u, g_s]), cfg.sigma)
-        keep, mass = self._strip(x_s, x_u, strip)
+        keep, mass = self._strip(x_s, x_u, cfg.stroke_strip)
         if keep is not None:
             x_u, g_u = x_u[keep], g_u[keep]
         return torch.cat([x_s, x_u]), torch.cat([g_s, g_u]), mass
@@ -685,59 +668,38 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
     t0 = time.perf_counter()
     f_final = run.best if run.best is not None else fit.solve_strokes_only()
     mesh = _extract(f_final, fit.frame, strokes, labels, cut_boundary)
-    finish = None
-    if (cfg.finish_steps > 0 or cfg.polish > 0) and not interrupted:
-        mesh, finish = _finished(fit, f_final, mesh, strokes, labels, cut_boundary, progress)
-        interrupted = finish["interrupted"]
+    polish = None
+    if cfg.polish > 0 and not interrupted:
+        mesh, polish = _polished(fit, f_final, mesh, strokes, labels, cut_boundary)
     V, F, f_np, origin, h_world, n_cut = mesh
-    timings["extract"] = time.perf_counter() - t0 - (finish or {}).get("seconds", 0.0)
-    if finish is not None and "seconds" in finish:
-        timings["finish"] = finish.pop("seconds")
+    timings["extract"] = time.perf_counter() - t0
     timings["total"] = time.perf_counter() - t_start
     report = {"steps": steps_done, "interrupted": interrupted, "device": str(dev), "seed": seed,
               "quality": quality, "config": cfg.as_dict(), "n_vertices": len(V),
               "n_faces": len(F), "cut_faces": n_cut,
               "stroke_length_unit": fit.sampler.total_length}
-    if finish is not None:
-        report["finish"] = finish
+    if polish is not None:
+        report["polish"] = polish
     return FlowResult(V, F, report, f_grid=f_np, origin=origin, spacing=h_world, timings=timings,
                       history=fit.history)
 
 
-def _finished(fit: _FlowFit, f, mesh, strokes, labels, cut_boundary, progress):
-    """The finished surface if it holds as much of the strokes as the full stage's.
+def _polished(fit: _FlowFit, f, mesh, strokes, labels, cut_boundary):
+    """The polished surface (:meth:`_FlowFit.polish`) if it holds as much of the strokes.
 
-    The finish stage (``cfg.finish_steps``: full steps with the stroke strip,
-    :meth:`_FlowFit.finish_stage`, a fresh Adam) and then the polish
-    (``cfg.polish``, :meth:`_FlowFit.polish`) run from the full stage's network and
-    ``f``, whose surface is ``mesh`` (:func:`_extract`'s tuple). The strip removes
-    the shrinking of the surface between smooth strokes; where the strokes' extra
-    density is what holds the surface on them (open rims, sparse sketches) it moves
-    the surface off them instead. So the finished surface is kept only when its
-    stroke fidelity (:func:`curvenet.evaluate.sketch_fidelity`) is at least that of
-    ``mesh``. Ctrl-C during the finish returns ``mesh``.
+    ``mesh`` is :func:`_extract`'s tuple for the last step's ``f``. The re-integration
+    removes Monte-Carlo noise and, with the strip, the shrinking of the surface between
+    smooth strokes; where the strokes' extra density is what holds the surface on them
+    (open rims, sparse sketches) it moves the surface off them instead. So the polished
+    surface is kept only when its stroke fidelity
+    (:func:`curvenet.evaluate.sketch_fidelity`) is at least that of ``mesh``.
 
-    Returns ``(mesh, info)``: ``info`` has ``interrupted``, ``kept``, and, when the
-    finish ran to its end, ``fidelity`` ([full stage's, finished]); with finish
-    steps also ``steps`` done and ``seconds``.
+    Returns ``(mesh, {"fidelity": [last step's, polished], "kept": bool})``.
     """
-    cfg = fit.cfg
-    info = {"interrupted": False}
-    if cfg.finish_steps > 0:
-        t0 = time.perf_counter()
-        run = train(fit.net.parameters(), [fit.finish_stage()], lr=cfg.lr,
-                    grad_clip=cfg.grad_clip, progress=progress, desc="neural finish")
-        info.update(steps=run.steps.get("finish", 0), seconds=time.perf_counter() - t0)
-        if run.interrupted or run.best is None:
-            info.update(interrupted=run.interrupted, kept=False)
-            return mesh, info
-        f = run.best
-    if cfg.polish > 0:
-        f = fit.polish(f)
-    finished = _extract(f, fit.frame, strokes, labels, cut_boundary)
-    fidelity = [_fidelity(m[0], m[1], strokes) for m in (mesh, finished)]
-    info.update(fidelity=fidelity, kept=fidelity[1] >= fidelity[0])
-    return (finished if info["kept"] else mesh), info
+    polished = _extract(fit.polish(f), fit.frame, strokes, labels, cut_boundary)
+    fidelity = [_fidelity(m[0], m[1], strokes) for m in (mesh, polished)]
+    kept = fidelity[1] >= fidelity[0]
+    return (polished if kept else mesh), {"fidelity": fidelity, "kept": kept}
 
 
 def _fidelity(V, F, strokes) -> float:

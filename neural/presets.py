@@ -31,13 +31,13 @@ the spheres stay round, but the extra density is also what holds a surface on
 strokes where it folds (the open rims of vns/dress.obj) and on most sketches whose
 strokes leave much of the surface open, and without it the surface leaves them
 (``benchmarks/README.md``). ``default`` therefore trains as the paper does and then
-finishes: 20 more full steps with the strip (``finish_steps=20``), which turn the
-trained g from the shrunken surface back to the round one. The finished surface is
-returned only when it holds at least as much of the strokes (stroke fidelity) as the
-full stage's: it does on smooth closed sketches (rough spheres) and does not where the
-extra density held the surface (there the full stage's surface is returned, the same
-as without the finish). ``polish`` (off in every preset) re-integrates the final f
-from more samples, optionally with the strip (``polish_strip``), guarded the same way.
+polishes: four re-integrations of the trained g with the strip, each from four
+times a step's samples, the surface ones drawn on the zero set of the one before
+(``polish=4, polish_rounds=4, polish_strip=1``). The polished surface is returned
+only when it holds at least as much of the strokes (stroke fidelity) as the last
+step's: it does on smooth closed sketches (rough spheres: no shrinking between the
+strokes) and does not where the extra density held the surface (dress and the
+other vns sketches keep the last step's surface, unchanged).
 ``paper`` keeps the published constants (no variant tried was better on
 every test shape). All presets solve the Poisson equation every ``poisson_every``
 steps and use the linearised data term in between (see :mod:`neural.flow`).
@@ -141,20 +141,14 @@ class FlowConfig:
         itself prefers that surface.
     dtype : str
         ``"float32"`` or ``"float64"``.
-    finish_steps : int
-        After the full stage, this many more full steps (fresh Adam, splat
-        normalised) with the stroke strip ``finish_strip``; 0 = none. The finished
-        surface (after the polish too, if any) is returned only when it holds at
-        least as much of the strokes as the full stage's (stroke fidelity, the share
-        of stroke length within 1 % of the strokes' diagonal); ``report["finish"]``
-        gives both figures. Not in the paper (see the notes above).
-    finish_strip : float
-        ``stroke_strip`` of the finish steps (cells).
     polish : int
-        After the full stage (and the finish steps), integrate f again (no
-        gradients) from this many times the stroke and surface samples of a step,
-        ``polish_rounds`` times, each round drawing its surface samples on the zero
-        set of the one before; 0 = none. Guarded like the finish steps.
+        After the last step, integrate f again (no gradients) from this many times
+        the stroke and surface samples of a step, ``polish_rounds`` times, each round
+        drawing its surface samples on the zero set of the one before; 0 keeps the
+        last step's f. The polished surface is returned only when it holds at least
+        as much of the strokes as the last step's (stroke fidelity, the share of
+        stroke length within 1 % of the strokes' diagonal); ``report["polish"]``
+        gives both figures. Not in the paper (see the notes above).
     polish_rounds : int
         Rounds of the polish (at least 1).
     polish_smooth_cells : float
@@ -198,8 +192,6 @@ class FlowConfig:
     geometric_init_steps: int = 100
     splat_volume: bool = False
     dtype: str = "float32"
-    finish_steps: int = 0
-    finish_strip: float = 1.0
     polish: int = 0
     polish_rounds: int = 1
     polish_smooth_cells: float = 0.0
@@ -215,7 +207,7 @@ PRESETS: dict[str, FlowConfig] = {
     "draft": FlowConfig(res=64, width=64, hidden_layers=2, n_stroke=1200, n_surface=1000,
                         n_volume=600, init_steps=40, steps=100, lr=3e-4, poisson_every=1,
                         w_smooth=0.1),
-    "default": FlowConfig(w_smooth=0.1, finish_steps=20),
+    "default": FlowConfig(w_smooth=0.1, polish=4, polish_rounds=4, polish_strip=1.0),
     "paper": FlowConfig(res=256, width=256, hidden_layers=4, n_stroke=10000, n_surface=15000,
                         n_volume=15000, init_steps=200, steps=800, lr=5e-5,
                         geometric_init_steps=0),
@@ -267,7 +259,7 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
         if int(v) != v or v < 1:
             raise ValueError(f"{name} must be a positive integer, got {v!r}")
     for name in ("hidden_layers", "init_steps", "steps", "prefit_steps",
-                 "geometric_init_steps", "polish", "finish_steps"):
+                 "geometric_init_steps", "polish"):
         v = getattr(cfg, name)
         if int(v) != v or v < 0:
             raise ValueError(f"{name} must be a non-negative integer, got {v!r}")
@@ -281,8 +273,7 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
         if not getattr(cfg, name) > 0:
             raise ValueError(f"{name} must be positive, got {getattr(cfg, name)!r}")
     for name in ("w_align", "w_smooth", "w_data", "w_eik", "w_curl", "w_normal", "grad_clip",
-                 "smooth_cells", "polish_smooth_cells", "stroke_strip", "polish_strip",
-                 "finish_strip"):
+                 "smooth_cells", "polish_smooth_cells", "stroke_strip", "polish_strip"):
         if not getattr(cfg, name) >= 0:
             raise ValueError(f"{name} must be non-negative, got {getattr(cfg, name)!r}")
     if not 0.0 <= cfg.normalize_from <= 1.0:

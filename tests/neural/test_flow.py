@@ -42,19 +42,6 @@ def test_result_fields_and_world_coordinates():
     assert r.f(r.origin[None])[0] == pytest.approx(1.0, abs=1e-5)
 
 
-def test_finish_steps_run_after_the_full_stage_and_report_the_choice():
-    r = fit_flow_surface(_circles(), progress=False, finish_steps=2, **TINY)
-    fin = r.report["finish"]
-    assert fin["steps"] == 2 and fin["interrupted"] is False and len(fin["fidelity"]) == 2
-    assert fin["kept"] is (fin["fidelity"][1] >= fin["fidelity"][0])
-    assert len(r.history["finish"]["data"]) == 2 and "finish" in r.timings
-    assert r.report["steps"] == {"init": 3, "full": 4}
-    plain = fit_flow_surface(_circles(), progress=False, **TINY)
-    assert "finish" not in plain.report and "finish" not in plain.history
-    if not fin["kept"]:                     # the full stage's surface, unchanged
-        assert np.array_equal(r.f_grid, plain.f_grid)
-
-
 def test_deterministic_on_cpu():
     a = fit_flow_surface(_circles(), progress=False, seed=3, **TINY)
     b = fit_flow_surface(_circles(), progress=False, seed=3, **TINY)
@@ -133,15 +120,12 @@ def _sphere_f(frame, res, radius):
 
 @pytest.mark.parametrize("last, polished, kept", [(1.0, 0.8, False), (0.8, 1.0, True),
                                                    (1.0, 1.0, True)])
-def test_finish_is_kept_only_when_it_holds_the_strokes(last, polished, kept):
-    # the strokes lie on the unit sphere: a finished (here polished) f whose zero set is
-    # the sphere of radius 0.8 is off them and the full stage's surface is returned; the
-    # other way round (and on a tie) the finished one
-    from curvenet.neural.presets import get_config
-
+def test_polish_is_kept_only_when_it_holds_the_strokes(last, polished, kept):
+    # the strokes lie on the unit sphere: a polished f whose zero set is the sphere of
+    # radius 0.8 is off them and the last step's surface is returned; the other way round
+    # (and on a tie) the polished one
     class Fit:
         frame = flow.Frame.from_points(np.vstack(_circles()), 0.2)
-        cfg = get_config("draft", polish=1)
 
         def polish(self, f):
             return _sphere_f(self.frame, 48, polished)
@@ -149,7 +133,7 @@ def test_finish_is_kept_only_when_it_holds_the_strokes(last, polished, kept):
     fit, strokes = Fit(), _circles()
     labels = ["crease"] * 3
     mesh = flow._extract(_sphere_f(fit.frame, 48, last), fit.frame, strokes, labels, True)
-    (V, _F, *_), info = flow._finished(fit, None, mesh, strokes, labels, True, False)
+    (V, _F, *_), info = flow._polished(fit, None, mesh, strokes, labels, True)
     assert info["kept"] is kept
     on, off = (0, 1) if last == 1.0 else (1, 0)
     assert info["fidelity"][on] == 1.0
