@@ -475,8 +475,9 @@ class _FlowFit:
         from .poisson import PoissonSolver
         cfg = self.cfg
         normalize = cfg.steps - 1 >= int(cfg.normalize_from * cfg.steps)   # as the last step
-        solver = PoissonSolver(cfg.res, device=self.dev, dtype=self.dtype,
-                               smooth_cells=cfg.polish_smooth_cells, boundary=cfg.boundary)
+        solver = self.solver if cfg.polish_smooth_cells == cfg.smooth_cells else PoissonSolver(
+            cfg.res, device=self.dev, dtype=self.dtype, smooth_cells=cfg.polish_smooth_cells,
+            boundary=cfg.boundary)
         with torch.no_grad():
             for _ in range(cfg.polish_rounds):
                 x_s = self._data_points(cfg.polish)
