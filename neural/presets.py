@@ -36,8 +36,8 @@ times a step's samples, the surface ones drawn on the zero set of the one before
 (``polish=4, polish_rounds=4, polish_strip=1``). The polished surface is returned
 only when it holds at least as much of the strokes (stroke fidelity) as the last
 step's: it does on smooth closed sketches (rough spheres: no shrinking between the
-strokes) and does not where the extra density held the surface (dress and the
-other vns sketches keep the last step's surface, unchanged).
+strokes; vns torus and trebol_flowrep) and does not where the extra density held the
+surface (dress and 19 other vns sketches keep the last step's surface, unchanged).
 ``paper`` keeps the published constants (no variant tried was better on
 every test shape). All presets solve the Poisson equation every ``poisson_every``
 steps and use the linearised data term in between (see :mod:`neural.flow`).
