@@ -96,17 +96,58 @@ def test_refine_prefit_reproduces_the_init_mesh():
     assert f >= 0.9, f
 
 
-def test_polish_keeps_the_surface_of_the_field():
-    # g prefitted to sigma * grad SDF of the unit sphere, no flow step: f re-integrated from
-    # 16 times the samples of a step (strokes and f's zero set), low-passed by one cell, must
-    # still be that sphere, the one the stroke circles lie on
+def _prefitted_sphere_fit(**overrides):
+    """A draft ``_FlowFit`` (res 48) whose g is prefitted to sigma * grad SDF of the unit sphere."""
+    import torch
     import trimesh
+
+    from curvenet.neural.presets import get_config
+    from curvenet.neural.training import train
     m = trimesh.creation.icosphere(3, radius=1.0)
-    r = fit_flow_surface(_circles(), progress=False, init_mesh=(m.vertices, m.faces),
-                         quality="draft", res=48, prefit_steps=150, steps=0, polish=16,
-                         polish_smooth_cells=1.0)
-    radius = np.linalg.norm(r.vertices, axis=1)
-    assert abs(radius.mean() - 1.0) < 0.02 and radius.std() < 0.01, (radius.mean(), radius.std())
+    cfg = get_config("draft", res=48, prefit_steps=150, **overrides)
+    fit = flow._FlowFit(_circles(), cfg, torch.device("cpu"), 0, (m.vertices, m.faces))
+    train(fit.net.parameters(), fit.stages()[:1], lr=cfg.lr)
+    return fit
+
+
+@pytest.mark.parametrize("radius", [0.9, 1.0, 1.08])
+def test_polish_returns_the_potential_of_g_not_the_old_surface(radius):
+    # g prefitted to the unit sphere, the one the stroke circles lie on; f's zero set is a
+    # sphere up to two cells (0.058 each) inside or outside it. Re-integrated on the band
+    # of nodes around that zero set, f is g's potential: its zero set is the unit sphere
+    # (up to the prefit's error), not the old one
+    fit = _prefitted_sphere_fit(polish=3)
+    f = fit.polish(_sphere_f(fit.frame, 48, radius))
+    V = flow._extract(f, fit.frame, _circles(), ["crease"] * 3, True)[0]
+    r = np.linalg.norm(V, axis=1)
+    assert abs(r.mean() - 1.0) < 0.02 and r.std() < 0.015, (r.mean(), r.std())
+
+
+def test_polish_of_f_without_a_zero_set_returns_it():
+    import torch
+    fit = _prefitted_sphere_fit(polish=3)
+    f = torch.ones(48, 48, 48)
+    assert fit.polish(f) is f
+
+
+def test_average_from_averages_the_last_steps_and_leaves_training_alone():
+    # the running mean starts at step int(average_from * steps) of the full stage; the
+    # steps themselves (losses, f) are those of a fit without it
+    from curvenet.neural.training import train
+    runs = {}
+    for average_from in (0.5, 1.0):
+        cfg = flow.get_config("draft", **TINY, polish=2, average_from=average_from)
+        fit = flow._FlowFit(_circles(), cfg, flow.torch_device("cpu"), 0, None)
+        run = train(fit.net.parameters(), fit.stages(), lr=cfg.lr)
+        runs[average_from] = (fit, run)
+    (fit, run), (plain, plain_run) = runs[0.5], runs[1.0]
+    assert plain.averaged is None and int(fit.averaged.n_averaged) == 2
+    for stage, terms in plain.history.items():
+        for term, values in terms.items():        # NaN where a term is not computed
+            np.testing.assert_array_equal(fit.history[stage][term], values)
+    assert bool((run.best == plain_run.best).all())
+    averaged = list(fit.averaged.module.parameters())
+    assert any(not bool((a == p).all()) for a, p in zip(averaged, fit.net.parameters()))
 
 
 def _sphere_f(frame, res, radius):
@@ -276,12 +317,12 @@ def test_stroke_strip_keeps_a_sphere_between_its_strokes():
 
 
 def test_stroke_strip_in_the_fit_keeps_the_sphere():
-    # g prefitted to the unit sphere, two normalised flow steps and the polish with the strip:
-    # the surface stays the sphere the stroke circles lie on
+    # g prefitted to the unit sphere, two normalised flow steps with the strip: the surface
+    # stays the sphere the stroke circles lie on
     import trimesh
     m = trimesh.creation.icosphere(3, radius=1.0)
     r = fit_flow_surface(_circles(), progress=False, init_mesh=(m.vertices, m.faces),
                          quality="draft", res=48, prefit_steps=150, steps=2, normalize_from=0.0,
-                         stroke_strip=1.0, polish=8, polish_strip=1.0)
+                         stroke_strip=1.0)
     radius = np.linalg.norm(r.vertices, axis=1)
     assert abs(radius.mean() - 1.0) < 0.02 and radius.std() < 0.015, (radius.mean(), radius.std())
