@@ -60,17 +60,16 @@ Engineering choices (documented deviations / gap fills)
   cylinder is a capsule, and box faces bulge into pillows
   (``benchmarks/bench_flow_limits.py`` measures both; the figures, and the
   terms tried against it, are in ``benchmarks/README.md``).
-* ``polish = b > 0`` integrates f once more, without gradients, from g on every grid
-  node within b cells of the last step's zero set (g is zero elsewhere); with
-  ``average_from < 1`` that g is the running mean of the network's parameters over
-  the full stage from that fraction on (stochastic weight averaging). A step's splat
-  puts f's jump where its surface samples are, so a surface that shrank between its
-  strokes stays there when re-integrated from samples; the band's f is g's potential
-  up to a constant, and Eq. 11 puts its zero level through the strokes. The averaged
-  g has less of the last steps' Monte-Carlo noise. The polished surface is returned
-  only when its stroke fidelity is at least the last step's (:func:`_polished`): on
-  sketches whose surface the strokes' extra density in the splat holds in place (open
-  rims), g's potential leaves them.
+* ``polish = k > 0`` re-integrates the final f (forward passes only) from k times
+  the stroke and surface samples of one step, ``polish_rounds`` times, optionally
+  with the stroke strip (``polish_strip``) and a low-pass: less Monte-Carlo noise in
+  the splat and, with the strip, no shrinking between smooth strokes. With
+  ``average_from < 1`` its g is the running mean of the network's parameters over the
+  full stage from that fraction on (stochastic weight averaging), which has less of
+  the last steps' noise than the last step's network. The polished
+  surface is returned only when its stroke fidelity is at least the last step's
+  (:func:`_polished`): on sketches whose surface the strokes' extra density holds
+  in place (open rims), the re-integration moves it off them.
 * Final mesh: pieces of the zero set with no stroke within 4 grid cells are
   dropped (spurious level-set components of the periodic f).
 * ``anchors`` (not in the paper): oriented points of another surface the fit must
@@ -442,12 +441,13 @@ class _FlowFit:
             full = Stage("full", cfg.steps, self._flow_step("full", cfg.steps))
         return [first, full]
 
-    def solve(self, points, values, normalize, need_adjoint, n_stroke=None, mass=None):
+    def solve(self, points, values, normalize, need_adjoint, n_stroke=None, mass=None,
+              solver=None):
         """Splat -> FFT Poisson -> Eq. 11; returns (f_grid, data loss, raw grid).
 
         The first ``n_stroke`` (default ``cfg.n_stroke``) points are the data samples
         (the stroke samples, then the anchors'); ``mass`` (optional, (M,)) weighs the
-        points in the splat.
+        points in the splat; ``solver`` (default the fit's) solves.
         """
         from .losses import data_loss
         from .poisson import interpolate, normalize_scale_shift, normalize_splat, splat
@@ -457,36 +457,45 @@ class _FlowFit:
             raw.retain_grad()
         if normalize:
             grid = normalize_splat(grid, wsum)
-        f = self.solver.solve(grid)
+        f = (solver or self.solver).solve(grid)
         f_s = interpolate(f, points[: n_stroke or self.cfg.n_stroke])
         f, f_s = normalize_scale_shift(f, f_s)
         return f, data_loss(f_s), raw
 
     def polish(self, f):
-        """f integrated from g on the band of nodes around f's zero set, without gradients.
+        """f re-integrated ``cfg.polish_rounds`` times with the trained g, without gradients.
 
-        g is the averaged network (:meth:`_average`) if there is one, else the last
-        step's; it is evaluated at the nodes within ``cfg.polish`` cells of a sign change
-        of ``f`` (:func:`neural.poisson.band_nodes`) and set to zero elsewhere. Inside the
-        band the solve returns g's potential up to a constant, whatever the old surface
-        was, and Eq. 11 shifts it to zero mean at ``4 * n_stroke`` stroke samples. ``f``
-        is returned as it is when it has no sign change.
+        Each round draws ``cfg.polish`` times the stroke and surface samples of a step
+        (the surface ones on the zero set of the round before), in the same proportion,
+        and splats them with the normalisation of the last step, leaving out the surface
+        samples within ``cfg.polish_strip`` cells of the strokes; the solve low-passes by
+        ``cfg.polish_smooth_cells``. The Monte-Carlo noise of the splat is down by about
+        ``sqrt(cfg.polish)``; the per-node normalisation sees ``cfg.polish`` times the
+        weight, so even one round without strip or low-pass is not quite a step's
+        field (``benchmarks/README.md``). g is the averaged network (:meth:`_average`)
+        if there is one, else the last step's.
         """
         import torch
 
-        from .poisson import band_nodes, interpolate, normalize_scale_shift
-        res = self.cfg.res
+        from .poisson import PoissonSolver
+        cfg = self.cfg
+        normalize = cfg.steps - 1 >= int(cfg.normalize_from * cfg.steps)   # as the last step
+        solver = self.solver if cfg.polish_smooth_cells == cfg.smooth_cells else PoissonSolver(
+            cfg.res, device=self.dev, dtype=self.dtype, smooth_cells=cfg.polish_smooth_cells,
+            boundary=cfg.boundary)
         net = self.net if self.averaged is None else self.averaged.module
         with torch.no_grad():
-            idx = torch.nonzero(band_nodes(f, self.cfg.polish))
-            if not len(idx):
-                return f
-            nodes = (idx.to(self.dtype) + 0.5) / res
-            g = torch.cat([net(p) for p in nodes.split(65536)])
-            grid = torch.zeros(3, res, res, res, device=self.dev, dtype=self.dtype)
-            grid[:, idx[:, 0], idx[:, 1], idx[:, 2]] = g.T
-            f = self.solver.solve(grid)
-            return normalize_scale_shift(f, interpolate(f, self._data_points(4)))[0]
+            for _ in range(cfg.polish_rounds):
+                x_s = self._data_points(cfg.polish)
+                x_u = sample_surface_cells(f, cfg.polish * cfg.n_surface, self.gen)
+                keep, mass = self._strip(x_s, x_u, cfg.polish_strip)
+                if keep is not None:
+                    x_u = x_u[keep]
+                pts = x_s if x_u is None else torch.cat([x_s, x_u])
+                vals = torch.cat([net(p) for p in pts.split(65536)])
+                f = self.solve(pts, vals, normalize, False, n_stroke=len(x_s), mass=mass,
+                               solver=solver)[0]
+        return f
 
     def _average(self):
         """Add the net's parameters to their running mean (``torch.optim.swa_utils``)."""
@@ -695,12 +704,12 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
 def _polished(fit: _FlowFit, f, mesh, strokes, labels, cut_boundary):
     """The polished surface (:meth:`_FlowFit.polish`) if it holds as much of the strokes.
 
-    ``mesh`` is :func:`_extract`'s tuple for the last step's ``f``. g's potential has no
-    Monte-Carlo noise and does not shrink between smooth strokes; where the strokes'
-    extra density in the splat is what holds the surface on them (open rims, sparse
-    sketches) it leaves them instead. So the polished surface is kept only when its
-    stroke fidelity (:func:`curvenet.evaluate.sketch_fidelity`) is at least that of
-    ``mesh``.
+    ``mesh`` is :func:`_extract`'s tuple for the last step's ``f``. The re-integration
+    removes Monte-Carlo noise and, with the strip, the shrinking of the surface between
+    smooth strokes; where the strokes' extra density is what holds the surface on them
+    (open rims, sparse sketches) it moves the surface off them instead. So the polished
+    surface is kept only when its stroke fidelity
+    (:func:`curvenet.evaluate.sketch_fidelity`) is at least that of ``mesh``.
 
     Returns ``(mesh, {"fidelity": [last step's, polished], "kept": bool})``.
     """

@@ -100,8 +100,8 @@ def stroke_strip(x_s, x_u, width: float):
     its strokes). Dropping the surface samples closer than ``width`` to a stroke
     sample and giving the stroke samples their mass keeps one density along the
     whole surface. Where the surface folds at a stroke (the rim of an open
-    surface) the extra density is also what holds it on the stroke, so no preset
-    trains with it (:mod:`neural.presets`).
+    surface) the extra density is also what holds it on the stroke, so the fits
+    train without it and use it only in their guarded polish (:mod:`neural.presets`).
 
     Parameters
     ----------
@@ -142,32 +142,6 @@ def normalize_splat(grid: torch.Tensor, weight: torch.Tensor) -> torch.Tensor:
     """
     wref = weight.sum() / (weight > 0).sum().clamp(min=1)
     return grid / torch.maximum(weight, wref)
-
-
-def band_nodes(f_grid: torch.Tensor, cells: int) -> torch.Tensor:
-    """The nodes within ``cells`` cells of a sign change of f (periodic grid).
-
-    A cell (the cube of nodes ``i .. i + 1`` on each axis, wrapping) changes sign when
-    its corners hold both signs; a node is in the band when such a cell lies within
-    ``cells`` cells of it on every axis (a cube neighbourhood; 0: the nodes of the
-    sign-change cells).
-
-    Parameters
-    ----------
-    f_grid : (res, res, res) tensor
-    cells : int, at least 0 and at most ``res - 1``
-
-    Returns
-    -------
-    (res, res, res) bool tensor
-    """
-    import torch.nn.functional as F
-    f5 = F.pad(f_grid.detach()[None, None], (0, 1) * 3, mode="circular")
-    hi = F.max_pool3d(f5, 2, stride=1)
-    lo = -F.max_pool3d(-f5, 2, stride=1)
-    cell = ((lo < 0) & (hi > 0)).to(f_grid.dtype)          # cell i: nodes i, i + 1
-    cell = F.pad(cell, (cells + 1, cells) * 3, mode="circular")
-    return F.max_pool3d(cell, 2 * cells + 2, stride=1)[0, 0] > 0
 
 
 def interpolate(grid: torch.Tensor, points: torch.Tensor, *, with_gradient: bool = False):

@@ -96,38 +96,17 @@ def test_refine_prefit_reproduces_the_init_mesh():
     assert f >= 0.9, f
 
 
-def _prefitted_sphere_fit(**overrides):
-    """A draft ``_FlowFit`` (res 48) whose g is prefitted to sigma * grad SDF of the unit sphere."""
-    import torch
+def test_polish_keeps_the_surface_of_the_field():
+    # g prefitted to sigma * grad SDF of the unit sphere, no flow step: f re-integrated from
+    # 16 times the samples of a step (strokes and f's zero set), low-passed by one cell, must
+    # still be that sphere, the one the stroke circles lie on
     import trimesh
-
-    from curvenet.neural.presets import get_config
-    from curvenet.neural.training import train
     m = trimesh.creation.icosphere(3, radius=1.0)
-    cfg = get_config("draft", res=48, prefit_steps=150, **overrides)
-    fit = flow._FlowFit(_circles(), cfg, torch.device("cpu"), 0, (m.vertices, m.faces))
-    train(fit.net.parameters(), fit.stages()[:1], lr=cfg.lr)
-    return fit
-
-
-@pytest.mark.parametrize("radius", [0.9, 1.0, 1.08])
-def test_polish_returns_the_potential_of_g_not_the_old_surface(radius):
-    # g prefitted to the unit sphere, the one the stroke circles lie on; f's zero set is a
-    # sphere up to two cells (0.058 each) inside or outside it. Re-integrated on the band
-    # of nodes around that zero set, f is g's potential: its zero set is the unit sphere
-    # (up to the prefit's error), not the old one
-    fit = _prefitted_sphere_fit(polish=3)
-    f = fit.polish(_sphere_f(fit.frame, 48, radius))
-    V = flow._extract(f, fit.frame, _circles(), ["crease"] * 3, True)[0]
-    r = np.linalg.norm(V, axis=1)
-    assert abs(r.mean() - 1.0) < 0.02 and r.std() < 0.015, (r.mean(), r.std())
-
-
-def test_polish_of_f_without_a_zero_set_returns_it():
-    import torch
-    fit = _prefitted_sphere_fit(polish=3)
-    f = torch.ones(48, 48, 48)
-    assert fit.polish(f) is f
+    r = fit_flow_surface(_circles(), progress=False, init_mesh=(m.vertices, m.faces),
+                         quality="draft", res=48, prefit_steps=150, steps=0, polish=16,
+                         polish_smooth_cells=1.0)
+    radius = np.linalg.norm(r.vertices, axis=1)
+    assert abs(radius.mean() - 1.0) < 0.02 and radius.std() < 0.01, (radius.mean(), radius.std())
 
 
 def test_average_from_averages_the_last_steps_and_leaves_training_alone():
@@ -148,6 +127,28 @@ def test_average_from_averages_the_last_steps_and_leaves_training_alone():
     assert bool((run.best == plain_run.best).all())
     averaged = list(fit.averaged.module.parameters())
     assert any(not bool((a == p).all()) for a, p in zip(averaged, fit.net.parameters()))
+
+
+def test_polish_integrates_the_averaged_network():
+    # the averaged copy holds g prefitted to the unit sphere and the net itself is zeroed
+    # afterwards: the polish must integrate the copy (the sphere), not the zero field
+    import torch
+    import trimesh
+
+    from curvenet.neural.presets import get_config
+    from curvenet.neural.training import train
+    m = trimesh.creation.icosphere(3, radius=1.0)
+    cfg = get_config("draft", res=48, prefit_steps=150, polish=16, polish_smooth_cells=1.0)
+    fit = flow._FlowFit(_circles(), cfg, torch.device("cpu"), 0, (m.vertices, m.faces))
+    train(fit.net.parameters(), fit.stages()[:1], lr=cfg.lr)
+    fit._average()
+    with torch.no_grad():
+        for p in fit.net.parameters():
+            p.zero_()
+    f = fit.polish(_sphere_f(fit.frame, 48, 1.0))
+    V = flow._extract(f, fit.frame, _circles(), ["crease"] * 3, True)[0]
+    r = np.linalg.norm(V, axis=1)
+    assert len(r) and abs(r.mean() - 1.0) < 0.02 and r.std() < 0.01, (r.mean(), r.std())
 
 
 def _sphere_f(frame, res, radius):
@@ -317,12 +318,12 @@ def test_stroke_strip_keeps_a_sphere_between_its_strokes():
 
 
 def test_stroke_strip_in_the_fit_keeps_the_sphere():
-    # g prefitted to the unit sphere, two normalised flow steps with the strip: the surface
-    # stays the sphere the stroke circles lie on
+    # g prefitted to the unit sphere, two normalised flow steps and the polish with the strip:
+    # the surface stays the sphere the stroke circles lie on
     import trimesh
     m = trimesh.creation.icosphere(3, radius=1.0)
     r = fit_flow_surface(_circles(), progress=False, init_mesh=(m.vertices, m.faces),
                          quality="draft", res=48, prefit_steps=150, steps=2, normalize_from=0.0,
-                         stroke_strip=1.0)
+                         stroke_strip=1.0, polish=8, polish_strip=1.0)
     radius = np.linalg.norm(r.vertices, axis=1)
     assert abs(radius.mean() - 1.0) < 0.02 and radius.std() < 0.015, (radius.mean(), radius.std())

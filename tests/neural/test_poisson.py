@@ -5,7 +5,7 @@ import math
 import pytest
 import torch
 
-from curvenet.neural.poisson import (PoissonSolver, band_nodes, interpolate, normalize_scale_shift,
+from curvenet.neural.poisson import (PoissonSolver, interpolate, normalize_scale_shift,
                                      normalize_splat, splat)
 
 
@@ -150,13 +150,3 @@ def test_gradcheck_splat_solve_interpolate():
 
     vals = torch.randn(5, 3, dtype=torch.float64, requires_grad=True)
     assert torch.autograd.gradcheck(fn, (vals,))
-
-
-@pytest.mark.parametrize("cells, band", [(0, [0, 7, 8, 15]), (1, [0, 1, 6, 7, 8, 9, 14, 15])])
-def test_band_nodes_of_a_plane_on_the_periodic_grid(cells, band):
-    # f = z - 1/2 changes sign between nodes 7 and 8 and, periodically, between 15 and 0;
-    # the band takes the nodes of those cells and ``cells`` more on each side
-    n = 16
-    z = (torch.arange(n, dtype=torch.float64) + 0.5) / n - 0.5
-    mask = band_nodes(z.expand(n, n, n).clone(), cells)
-    assert mask[:, :, band].all() and int(mask.sum()) == n * n * len(band)
