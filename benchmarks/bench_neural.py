@@ -73,17 +73,15 @@ def _worker(spec: dict) -> dict:
     if spec["kind"] == "sketch":
         from curvenet.io import read_sketch
         sk = read_sketch(spec["path"])
-        strokes, labels = sk.strokes, sk.labels
     elif spec["kind"] == "sphere":
         from curvenet.redraw import rough_sketch
         from curvenet.shapes import latlong_sphere
         shape = latlong_sphere(n_lat=2, n_lon=6)
         sk = rough_sketch(shape.network, seed=spec.get("sketch_seed", 0), split=0.0,
                           overdraw=0.0)
-        strokes, labels = sk.strokes, sk.labels
     else:
         shape, sk = _heldout_sketch(spec["shape"], spec["noise"], spec["sketch_seed"])
-        strokes, labels = sk.strokes, sk.labels
+    strokes, labels = sk.strokes, sk.labels
     out["strokes"] = len(strokes)
     t, cpu = time.perf_counter(), time.process_time()
     device = spec.get("device", "cpu")
@@ -137,19 +135,20 @@ def _tremor_sketch(shape, seed: int):
     """
     import numpy as np
 
+    from curvenet.core.geometry import arc_length, interpolate_polyline
     from curvenet.sketch import Sketch
     rng = np.random.default_rng(seed)
     ref = shape.reference_mesh(5)
     diag = float(np.linalg.norm(ref.vertices.max(0) - ref.vertices.min(0)))
     strokes = []
     for edge in shape.network.edges:
-        c = np.asarray(edge.curve, float)
-        s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(c, axis=0), axis=1))]
-        t = np.sort(rng.uniform(0.0, s[-1], max(12, int(len(c) * rng.uniform(0.6, 1.5)))))
-        p = np.stack([np.interp(t, s, c[:, k]) for k in range(3)], axis=1)
+        length = arc_length(edge.curve)
+        n = max(12, int(len(edge.curve) * rng.uniform(0.6, 1.5)))
+        t = np.sort(rng.uniform(0.0, length, n))
+        p = interpolate_polyline(edge.curve, t)
         _, _, tri = ref.nearest.on_surface(p)
         phase, waves = rng.uniform(0, 2 * np.pi, 3), rng.uniform(1, 4, 3)
-        offset = np.sin(np.outer(t / s[-1] * np.pi, waves) + phase).mean(1) * 0.006 * diag
+        offset = np.sin(np.outer(t / length * np.pi, waves) + phase).mean(1) * 0.006 * diag
         p = p + offset[:, None] * ref.face_normals[tri] + rng.normal(scale=0.0015 * diag,
                                                                      size=p.shape)
         cuts = np.sort(rng.choice(np.arange(4, len(p) - 4), rng.integers(0, 3), replace=False))
