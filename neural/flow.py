@@ -66,7 +66,10 @@ Engineering choices (documented deviations / gap fills)
   the splat and, with the strip, no shrinking between smooth strokes. With
   ``average_from < 1`` its g is the running mean of the network's parameters over the
   full stage from that fraction on (stochastic weight averaging), which has less of
-  the last steps' noise than the last step's network. The polished
+  the last steps' noise than the last step's network, and it starts from the running
+  mean of those steps' f (Polyak averaging of the field): the last step's zero set
+  carries its splat's Monte-Carlo bumps, and a round of the polish moves a surface
+  only part of the way, so it keeps much of them. The polished
   surface is returned only when its stroke fidelity is at least the last step's
   (:func:`_polished`): on sketches whose surface the strokes' extra density holds
   in place (open rims), the re-integration moves it off them.
@@ -402,6 +405,7 @@ class _FlowFit:
         self.lam = None                # d(data loss) / d(splat), for poisson_every > 1
         self.data = float("nan")       # the last solved data loss
         self.averaged = None           # AveragedModel of the net (average_from < 1, polish)
+        self.f_mean = None             # running mean of the solved f over the same steps
         self.anchors = None if anchors is None else tuple(
             torch.as_tensor(a, device=dev, dtype=self.dtype)
             for a in (self.frame.to_unit(anchors[0]), anchors[1]))
@@ -473,7 +477,8 @@ class _FlowFit:
         ``sqrt(cfg.polish)``; the per-node normalisation sees ``cfg.polish`` times the
         weight, so even one round without strip or low-pass is not quite a step's
         field (``benchmarks/README.md``). g is the averaged network (:meth:`_average`)
-        if there is one, else the last step's.
+        if there is one, else the last step's; the first round's surface samples lie on
+        the zero set of the averaged f if there is one, else of ``f``.
         """
         import torch
 
@@ -484,6 +489,7 @@ class _FlowFit:
             cfg.res, device=self.dev, dtype=self.dtype, smooth_cells=cfg.polish_smooth_cells,
             boundary=cfg.boundary)
         net = self.net if self.averaged is None else self.averaged.module
+        f = f if self.f_mean is None else self.f_mean
         with torch.no_grad():
             for _ in range(cfg.polish_rounds):
                 x_s = self._data_points(cfg.polish)
@@ -498,11 +504,19 @@ class _FlowFit:
         return f
 
     def _average(self):
-        """Add the net's parameters to their running mean (``torch.optim.swa_utils``)."""
+        """Add the net's parameters (``torch.optim.swa_utils``) and the last solved f
+        (``self.f``, a (res, res, res) grid normalised by Eq. 11) to their running means.
+
+        Every step's f puts the stroke samples' mean at 0 and the box corner at +-1, so
+        their mean does too; its zero set has less of the steps' Monte-Carlo noise.
+        """
         from torch.optim.swa_utils import AveragedModel
         if self.averaged is None:
             self.averaged = AveragedModel(self.net)
         self.averaged.update_parameters(self.net)
+        n = int(self.averaged.n_averaged)
+        self.f_mean = self.f.clone() if n == 1 else self.f_mean.add_(self.f - self.f_mean,
+                                                                     alpha=1.0 / n)
 
     def solve_strokes_only(self, mesh_points=None):
         """f integrated from g at stroke samples (and ``mesh_points``), without gradients."""

@@ -113,14 +113,25 @@ def test_average_from_averages_the_last_steps_and_leaves_training_alone():
     # the running mean starts at step int(average_from * steps) of the full stage; the
     # steps themselves (losses, f) are those of a fit without it
     from curvenet.neural.training import train
-    runs = {}
+    runs, fields = {}, []
     for average_from in (0.5, 1.0):
         cfg = flow.get_config("draft", **TINY, polish=2, average_from=average_from)
         fit = flow._FlowFit(_circles(), cfg, flow.torch_device("cpu"), 0, None)
+        record = fit._record
+
+        def keep_f(stage, k, row, fit=fit, record=record):
+            record(stage, k, row)
+            if stage == "full" and fit.averaged is not None:
+                fields.append(fit.f.clone())
+
+        fit._record = keep_f
         run = train(fit.net.parameters(), fit.stages(), lr=cfg.lr)
         runs[average_from] = (fit, run)
     (fit, run), (plain, plain_run) = runs[0.5], runs[1.0]
-    assert plain.averaged is None and int(fit.averaged.n_averaged) == 2
+    assert plain.averaged is None and plain.f_mean is None
+    assert int(fit.averaged.n_averaged) == 2 and len(fields) == 2
+    # the field's running mean is the mean of the same two steps' f
+    assert float((fit.f_mean - (fields[0] + fields[1]) / 2).abs().max()) < 1e-6
     for stage, terms in plain.history.items():
         for term, values in terms.items():        # NaN where a term is not computed
             np.testing.assert_array_equal(fit.history[stage][term], values)
@@ -141,11 +152,33 @@ def test_polish_integrates_the_averaged_network():
     cfg = get_config("draft", res=48, prefit_steps=150, polish=16, polish_smooth_cells=1.0)
     fit = flow._FlowFit(_circles(), cfg, torch.device("cpu"), 0, (m.vertices, m.faces))
     train(fit.net.parameters(), fit.stages()[:1], lr=cfg.lr)
+    fit.f = _sphere_f(fit.frame, 48, 1.0)
     fit._average()
     with torch.no_grad():
         for p in fit.net.parameters():
             p.zero_()
     f = fit.polish(_sphere_f(fit.frame, 48, 1.0))
+    V = flow._extract(f, fit.frame, _circles(), ["crease"] * 3, True)[0]
+    r = np.linalg.norm(V, axis=1)
+    assert len(r) and abs(r.mean() - 1.0) < 0.02 and r.std() < 0.01, (r.mean(), r.std())
+
+
+def test_polish_starts_from_the_averaged_field():
+    # g prefitted to the unit sphere, the averaged f is that sphere and the last step's f
+    # a sphere of radius 0.6: a round moves a surface only part of the way, so the polish
+    # returns the unit sphere only if its first samples lie on the averaged f's zero set
+    import torch
+    import trimesh
+
+    from curvenet.neural.presets import get_config
+    from curvenet.neural.training import train
+    m = trimesh.creation.icosphere(3, radius=1.0)
+    cfg = get_config("draft", res=48, prefit_steps=150, polish=16, polish_smooth_cells=1.0)
+    fit = flow._FlowFit(_circles(), cfg, torch.device("cpu"), 0, (m.vertices, m.faces))
+    train(fit.net.parameters(), fit.stages()[:1], lr=cfg.lr)
+    fit.f = _sphere_f(fit.frame, 48, 1.0)
+    fit._average()
+    f = fit.polish(_sphere_f(fit.frame, 48, 0.6))
     V = flow._extract(f, fit.frame, _circles(), ["crease"] * 3, True)[0]
     r = np.linalg.norm(V, axis=1)
     assert len(r) and abs(r.mean() - 1.0) < 0.02 and r.std() < 0.01, (r.mean(), r.std())
