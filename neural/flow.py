@@ -507,16 +507,19 @@ class _FlowFit:
         """Add the net's parameters (``torch.optim.swa_utils``) and the last solved f
         (``self.f``, a (res, res, res) grid normalised by Eq. 11) to their running means.
 
-        Every step's f puts the stroke samples' mean at 0 and the box corner at +-1, so
-        their mean does too; its zero set has less of the steps' Monte-Carlo noise.
+        Every step's f puts its stroke samples' mean at 0 and the box corner at +-1; each
+        is added signed so that the corner is +1 (g's orientation is the fit's choice),
+        so their mean does the same, and its zero set has less of the steps'
+        Monte-Carlo noise.
         """
+        import torch
         from torch.optim.swa_utils import AveragedModel
         if self.averaged is None:
             self.averaged = AveragedModel(self.net)
         self.averaged.update_parameters(self.net)
         n = int(self.averaged.n_averaged)
-        self.f_mean = self.f.clone() if n == 1 else self.f_mean.add_(self.f - self.f_mean,
-                                                                     alpha=1.0 / n)
+        f = self.f * torch.sign(self.f[0, 0, 0])
+        self.f_mean = f if n == 1 else self.f_mean.add_(f - self.f_mean, alpha=1.0 / n)
 
     def solve_strokes_only(self, mesh_points=None):
         """f integrated from g at stroke samples (and ``mesh_points``), without gradients."""
