@@ -35,7 +35,10 @@ polishes: four re-integrations of the trained g with the strip, each from four
 times a step's samples, the surface ones drawn on the zero set of the one before
 (``polish=4, polish_rounds=4, polish_strip=1``), with the network's parameters
 averaged over the last 40 % of the full stage (``average_from=0.6``, stochastic
-weight averaging: less of the last steps' noise). The polished surface is returned
+weight averaging: less of the last steps' noise), the first round's surface samples
+drawn on the zero set of the mean of those steps' f (a round moves a surface only
+part of the way, and a single step's zero set carries its splat's Monte-Carlo
+bumps). The polished surface is returned
 only when it holds at least as much of the strokes (stroke fidelity) as the last
 step's: it does on smooth closed sketches (rough spheres: no shrinking between the
 strokes; vns torus and trebol_flowrep) and does not where the extra density held the
@@ -163,10 +166,11 @@ class FlowConfig:
     polish_strip : float
         ``stroke_strip`` of the polish's splats (cells; 0 = none).
     average_from : float
-        Fraction of the full stage from which the network's parameters are averaged
-        (a running mean, stochastic weight averaging) for the polish, which then
-        integrates the averaged network's g; 1 = no averaging (the last step's
-        network). Training itself is unchanged.
+        Fraction of the full stage from which the network's parameters and the
+        solved f are averaged (running means; stochastic weight averaging of the
+        parameters) for the polish, which then integrates the averaged network's g
+        from the averaged f's zero set; 1 = no averaging (the last step's
+        network and f). Training itself is unchanged.
     stroke_strip : float
         Surface samples closer than this many grid cells to a stroke sample are
         left out of the full stage's splat and the stroke samples carry their mass
