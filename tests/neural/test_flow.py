@@ -141,48 +141,45 @@ def test_average_from_averages_the_last_steps_and_leaves_training_alone():
     assert any(not bool((a == p).all()) for a, p in zip(averaged, fit.net.parameters()))
 
 
+def _averaged_sphere_fit():
+    """A fit whose g is prefitted to the unit sphere, averaged once with f = that sphere."""
+    import torch
+    import trimesh
+
+    from curvenet.neural.presets import get_config
+    from curvenet.neural.training import train
+    m = trimesh.creation.icosphere(3, radius=1.0)
+    cfg = get_config("draft", res=48, prefit_steps=150, polish=16, polish_smooth_cells=1.0)
+    fit = flow._FlowFit(_circles(), cfg, torch.device("cpu"), 0, (m.vertices, m.faces))
+    train(fit.net.parameters(), fit.stages()[:1], lr=cfg.lr)
+    fit.f = _sphere_f(fit.frame, 48, 1.0)
+    fit._average()
+    return fit
+
+
+def _assert_polish_is_unit_sphere(fit, f):
+    V = flow._extract(fit.polish(f), fit.frame, _circles(), ["crease"] * 3, True)[0]
+    r = np.linalg.norm(V, axis=1)
+    assert len(r) and abs(r.mean() - 1.0) < 0.02 and r.std() < 0.01, (r.mean(), r.std())
+
+
 def test_polish_integrates_the_averaged_network():
     # the averaged copy holds g prefitted to the unit sphere and the net itself is zeroed
     # afterwards: the polish must integrate the copy (the sphere), not the zero field
     import torch
-    import trimesh
-
-    from curvenet.neural.presets import get_config
-    from curvenet.neural.training import train
-    m = trimesh.creation.icosphere(3, radius=1.0)
-    cfg = get_config("draft", res=48, prefit_steps=150, polish=16, polish_smooth_cells=1.0)
-    fit = flow._FlowFit(_circles(), cfg, torch.device("cpu"), 0, (m.vertices, m.faces))
-    train(fit.net.parameters(), fit.stages()[:1], lr=cfg.lr)
-    fit.f = _sphere_f(fit.frame, 48, 1.0)
-    fit._average()
+    fit = _averaged_sphere_fit()
     with torch.no_grad():
         for p in fit.net.parameters():
             p.zero_()
-    f = fit.polish(_sphere_f(fit.frame, 48, 1.0))
-    V = flow._extract(f, fit.frame, _circles(), ["crease"] * 3, True)[0]
-    r = np.linalg.norm(V, axis=1)
-    assert len(r) and abs(r.mean() - 1.0) < 0.02 and r.std() < 0.01, (r.mean(), r.std())
+    _assert_polish_is_unit_sphere(fit, _sphere_f(fit.frame, 48, 1.0))
 
 
 def test_polish_starts_from_the_averaged_field():
-    # g prefitted to the unit sphere, the averaged f is that sphere and the last step's f
-    # a sphere of radius 0.6: a round moves a surface only part of the way, so the polish
-    # returns the unit sphere only if its first samples lie on the averaged f's zero set
-    import torch
-    import trimesh
-
-    from curvenet.neural.presets import get_config
-    from curvenet.neural.training import train
-    m = trimesh.creation.icosphere(3, radius=1.0)
-    cfg = get_config("draft", res=48, prefit_steps=150, polish=16, polish_smooth_cells=1.0)
-    fit = flow._FlowFit(_circles(), cfg, torch.device("cpu"), 0, (m.vertices, m.faces))
-    train(fit.net.parameters(), fit.stages()[:1], lr=cfg.lr)
-    fit.f = _sphere_f(fit.frame, 48, 1.0)
-    fit._average()
-    f = fit.polish(_sphere_f(fit.frame, 48, 0.6))
-    V = flow._extract(f, fit.frame, _circles(), ["crease"] * 3, True)[0]
-    r = np.linalg.norm(V, axis=1)
-    assert len(r) and abs(r.mean() - 1.0) < 0.02 and r.std() < 0.01, (r.mean(), r.std())
+    # the averaged f is the unit sphere and the last step's f a sphere of radius 0.6: a
+    # round moves a surface only part of the way, so the polish returns the unit sphere
+    # only if its first samples lie on the averaged f's zero set
+    fit = _averaged_sphere_fit()
+    _assert_polish_is_unit_sphere(fit, _sphere_f(fit.frame, 48, 0.6))
 
 
 def _sphere_f(frame, res, radius):
