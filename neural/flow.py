@@ -599,7 +599,8 @@ class _FlowFit:
             g_sv, G_sv = net.jet(torch.cat([x_s, x_v]), order=1)
             g_s, G_s = g_sv[: cfg.n_stroke], G_sv[: cfg.n_stroke]
             x_u = self._surface_samples(cfg.n_surface) if full else None
-            vals = {"align": alignment_loss(g_s, G_s, t_s), "curl": curl_loss(G_sv[cfg.n_stroke:])}
+            vals = {"align": alignment_loss(g_s, G_s, t_s, cfg.align_penalty),
+                    "curl": curl_loss(G_sv[cfg.n_stroke:])}
             x_s, g_s = self._anchor_terms(vals, x_s, g_s)
             pts, gv, mass = self._surface_terms(vals, x_u, x_s, g_s)
             if cfg.splat_volume:

@@ -27,20 +27,23 @@ __all__ = ["alignment_loss", "smoothness_loss", "smoothness_loss_autograd", "dat
            "eikonal_loss", "curl_loss", "normal_loss"]
 
 
-def alignment_loss(g, G, tangents):
+def alignment_loss(g, G, tangents, penalty: str = "square"):
     """Eq. 4: mean of ``(cos 4 alpha - 1)^2`` over stroke samples.
 
     Parameters
     ----------
     g : (N, 3), G : (N, 3, 3), tangents : (N, 3)
+    penalty : {"square", "abs"}
+        ``"square"`` is Eq. 4; ``"abs"`` charges ``|cos 4 alpha - 1|``, as the published
+        code does (its gradient does not vanish as a stroke comes into line).
 
     Returns
     -------
-    scalar tensor in ``[0, 4]``; samples with no defined principal direction
-    (umbilic or tangent normal to the surface) contribute 0.
+    scalar tensor in ``[0, 4]`` (``"abs"``: ``[0, 2]``); samples with no defined
+    principal direction (umbilic or tangent normal to the surface) contribute 0.
     """
     cos4, _ = alignment_cos4(g, G, tangents)
-    return ((cos4 - 1.0) ** 2).mean()
+    return ((cos4 - 1.0) ** 2 if penalty == "square" else (cos4 - 1.0).abs()).mean()
 
 
 def smoothness_loss(g, G, H):

@@ -117,6 +117,9 @@ class FlowConfig:
         Adam learning rate. grad_clip : float, gradient-norm clip (0 = off).
     w_align, w_smooth, w_data, w_eik, w_curl : float
         Loss weights of Eq. 13 (paper: 1, 0.01, 30, 7, 7).
+    align_penalty : str
+        ``"square"`` (Eq. 4: ``(cos 4 alpha - 1)^2``) or ``"abs"`` (``|cos 4 alpha - 1|``,
+        the published code's) for the alignment term.
     w_normal : float
         Weight of the anchors' normal term (:func:`neural.losses.normal_loss`; only
         with ``anchors``, not in the paper).
@@ -197,6 +200,7 @@ class FlowConfig:
     w_eik: float = 7.0
     w_curl: float = 7.0
     w_normal: float = 7.0
+    align_penalty: str = "square"
     sigma: float = 0.5
     poisson_every: int = 1
     normalize_from: float = 0.6
@@ -230,8 +234,9 @@ PRESETS: dict[str, FlowConfig] = {
                         geometric_init_steps=0),
 }
 
-_CHOICES = {"boundary": ("periodic", "dirichlet"), "surface_sampler": ("cells", "marching_cubes"),
-            "smooth_mode": ("jet", "autograd"), "dtype": ("float32", "float64")}
+_CHOICES = {"align_penalty": ("square", "abs"), "boundary": ("periodic", "dirichlet"),
+            "surface_sampler": ("cells", "marching_cubes"), "smooth_mode": ("jet", "autograd"),
+            "dtype": ("float32", "float64")}
 
 
 def _from_preset(presets: dict, quality: str, overrides: dict, what: str):
