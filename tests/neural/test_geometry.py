@@ -69,6 +69,15 @@ def test_cylinder_principal_direction_along_axis_and_alignment_zero():
     a = math.pi / 8
     t = math.cos(a) * circle + math.sin(a) * ruling
     assert abs(float(alignment_loss(g, G, t)) - 1.0) < 1e-10
+    # the published code's |cos 4a - 1|: 0 on the principal directions, 2 at 45 degrees,
+    # 1 at 22.5 and 1 - cos(4 a) = 1 - 1/sqrt(2) at 11.25
+    assert float(alignment_loss(g, G, ruling, "abs")) < 1e-10
+    assert abs(float(alignment_loss(g, G, helix, "abs")) - 2.0) < 1e-10
+    assert abs(float(alignment_loss(g, G, t, "abs")) - 1.0) < 1e-10
+    a = math.pi / 16
+    t = math.cos(a) * circle + math.sin(a) * ruling
+    assert abs(float(alignment_loss(g, G, t, "abs")) - (1 - 1 / math.sqrt(2))) < 1e-10
+    assert abs(float(alignment_loss(g, G, t)) - (1 - 1 / math.sqrt(2)) ** 2) < 1e-10
 
 
 def test_alignment_is_frame_and_scale_invariant():
