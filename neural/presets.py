@@ -66,6 +66,12 @@ term is ``|cos 4a - 1|`` at stroke samples jittered by 0.002; its SIREN takes th
 unit-cube coordinates as they are (here mapped to [-1, 1], twice the first layer's
 frequency); it puts the sketch's longest side at 0.7 of the box (padding 0.21). It
 draws 10k stroke, 15k surface (marching-cubes mesh) and 15k volume samples per step.
+Measured against ``default`` (``benchmarks/README.md``): the data term, the low-pass,
+the splat normalisation, the sample proportions, the one-sided Eikonal term, the
+alignment term (``align_penalty="abs"``) and the box; each helped the spheres or some
+sketches and cost others stroke fidelity, so none is in a preset. Not measured: the
+distance-scaled smoothness term (its weight has no counterpart here without choosing
+a reference sketch), the jitter of the alignment samples and the SIREN's input scale.
 
 References
 ----------
