@@ -24,7 +24,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from curvenet.batch import BatchOptions, DaskExecutor, LocalExecutor, run_batch
+from curvenet.batch.run import BatchOptions, DaskExecutor, LocalExecutor, run_batch
 
 DATA = Path(os.environ.get("CURVENET_DATA",
                            Path(__file__).resolve().parents[1].parent / "shared" / "data"))

@@ -1,6 +1,6 @@
 """Benchmark of the CAD output (issue 21): B-spline faces in STEP, read back and checked.
 
-For every analytic shape of ``curvenet.shapes`` and every public network in
+For every analytic shape of ``curvenet.datasets.shapes`` and every public network in
 ``$CURVENET_DATA/networks`` (default ``../shared/data``): surface it on the classical
 route, export STEP, read it back with OpenCascade and print
 
@@ -33,8 +33,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from curvenet import cad, shapes  # noqa: E402
-from curvenet.errors import CurvenetError  # noqa: E402
+from curvenet import cad  # noqa: E402
+from curvenet.datasets import shapes  # noqa: E402
+from curvenet.core.errors import CurvenetError  # noqa: E402
 from curvenet.pipeline import surface  # noqa: E402
 
 HEADER = (f"{'input':<28s} {'patches':>7s} {'faces':>5s} {'exact':>5s} {'/patch':>6s} "

@@ -141,8 +141,8 @@ def bench_caps(args) -> None:
     import torch
     import trimesh
 
-    from curvenet.evaluate import evaluate_mesh
-    from curvenet.shapes import capped_cylinder
+    from curvenet.evaluate.metrics import evaluate_mesh
+    from curvenet.datasets.shapes import capped_cylinder
 
     torch.set_num_threads(args.threads)
     print("smoothness energy (Zhang 2025 Eq. 5) near the top cap of a capped cylinder r=0.5:")
@@ -173,8 +173,8 @@ class _Oracle:
     def __init__(self, name: str, res: int, n_stroke: int):
         import torch
 
-        from curvenet.redraw import rough_sketch
-        from curvenet.shapes import SHAPES
+        from curvenet.datasets.redraw import rough_sketch
+        from curvenet.datasets.shapes import SHAPES
         from curvenet.neural.flow import Frame, StrokeSampler
         from curvenet.neural.poisson import PoissonSolver
 
@@ -214,7 +214,7 @@ class _Oracle:
 def bench_splat(args) -> None:
     import torch
 
-    from curvenet.evaluate import evaluate_mesh
+    from curvenet.evaluate.metrics import evaluate_mesh
 
     torch.set_num_threads(args.threads)
     oracle = _Oracle(args.shape, args.res, args.stroke_samples)
@@ -238,7 +238,7 @@ def bench_refit(args) -> None:
     import torch
 
     from bench_sharpnet import box_dihedrals
-    from curvenet.evaluate import evaluate_mesh
+    from curvenet.evaluate.metrics import evaluate_mesh
     from curvenet.neural.creases import crease_refine
     from curvenet.neural.extract import keep_supported_components
 

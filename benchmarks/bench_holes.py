@@ -4,7 +4,7 @@ public clean networks (patch counts, holes, stroke distance, output size, time).
 Run ``CURVENET_DATA=/work/shared/data python benchmarks/bench_holes.py [--no-data]``.
 Prints two tables:
 
-1. every :data:`curvenet.shapes.CAD_SHAPES` network through ``surface(method="classical")``:
+1. every :data:`curvenet.datasets.shapes.CAD_SHAPES` network through ``surface(method="classical")``:
    patches, holes, seconds, triangles, F-score at 0.01 against the true surface
    (30k samples), and the flatness of the flat faces (largest distance of an
    output vertex of a face whose boundary is planar to that plane, fraction of
@@ -24,11 +24,11 @@ from pathlib import Path
 
 import numpy as np
 
-from curvenet import shapes
-from curvenet.cycles import find_patches
-from curvenet.errors import CurvenetError
-from curvenet.evaluate import evaluate_mesh, stroke_distance
-from curvenet.loops import orient_boundaries
+from curvenet.datasets import shapes
+from curvenet.cycles.find import find_patches
+from curvenet.core.errors import CurvenetError
+from curvenet.evaluate.metrics import evaluate_mesh, stroke_distance
+from curvenet.cycles.loops import orient_boundaries
 from curvenet.pipeline import surface
 from curvenet.surfacing.holes import surface_boundaries
 

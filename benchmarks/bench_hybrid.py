@@ -12,10 +12,10 @@ appended to ``--out`` as soon as it is done (a run stopped early keeps its rows)
 route, the seconds, and the share of stroke length within 1% of the sketch's diagonal
 of the surface alone and of the surface and the wires kept beside it (when the result
 has any), with the median and 95th percentile of the stroke-to-surface distance. For the
-neural fills of hybrid results, the seam figures of :func:`curvenet.hybrid.fill_seam`
+neural fills of hybrid results, the seam figures of :func:`curvenet.route.hybrid.fill_seam`
 (one value per fill, comma-separated): ``seam_fit`` and ``seam`` (share of the reached
 patch-shared curve length where the fill's boundary lies within 1% of the diagonal, as
-fitted and after :func:`curvenet.hybrid.close_seam`), ``seam_p95`` (95th percentile of
+fitted and after :func:`curvenet.route.hybrid.close_seam`), ``seam_p95`` (95th percentile of
 that distance, fraction of the diagonal). ``--sketches`` runs only the sketches of those
 names (file stems, or ``SET/STEM``); ``--hybrid-only`` only those that :data:`HYBRID`
 lists (the sketches ``auto`` surfaces with a neural fill).
@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 import curvenet
-from curvenet.evaluate import stroke_distance
+from curvenet.evaluate.metrics import stroke_distance
 
 DATA = Path(os.environ.get("CURVENET_DATA",
                            Path(__file__).resolve().parents[1].parent / "shared" / "data"))

@@ -71,11 +71,11 @@ def _worker(spec: dict) -> dict:
     from curvenet.neural.flow import fit_flow_surface
     out = {}
     if spec["kind"] == "sketch":
-        from curvenet.io import read_sketch
+        from curvenet.io.sketch import read_sketch
         sk = read_sketch(spec["path"])
     elif spec["kind"] == "sphere":
-        from curvenet.redraw import rough_sketch
-        from curvenet.shapes import latlong_sphere
+        from curvenet.datasets.redraw import rough_sketch
+        from curvenet.datasets.shapes import latlong_sphere
         shape = latlong_sphere(n_lat=2, n_lon=6)
         sk = rough_sketch(shape.network, seed=spec.get("sketch_seed", 0), split=0.0,
                           overdraw=0.0)
@@ -97,7 +97,7 @@ def _worker(spec: dict) -> dict:
     if device.startswith("cuda"):
         out["gpu_peak_gb"] = torch.cuda.max_memory_allocated() / 1e9
     if spec["kind"] != "sphere" and len(r.faces):
-        from curvenet.evaluate import sketch_fidelity
+        from curvenet.evaluate.metrics import sketch_fidelity
         out["fidelity"] = sketch_fidelity((r.vertices, r.faces), sk)["surface"]
     if spec["kind"] != "sketch":
         from tests.neural._metrics import fscore
@@ -115,8 +115,8 @@ HELDOUT = [("ellipsoid", "rough", 0), ("torus", "rough", 0), ("sphere", "tremor"
 
 def _heldout_sketch(name: str, noise: str, seed: int):
     """``(AnalyticShape, Sketch)`` of the heldout section (``noise``: rough or tremor)."""
-    from curvenet.redraw import rough_sketch
-    from curvenet.shapes import SHAPES, latlong_sphere
+    from curvenet.datasets.redraw import rough_sketch
+    from curvenet.datasets.shapes import SHAPES, latlong_sphere
     if noise == "rough":
         shape = SHAPES[name]()
         return shape, rough_sketch(shape.network, seed=seed)
@@ -136,7 +136,7 @@ def _tremor_sketch(shape, seed: int):
     import numpy as np
 
     from curvenet.core.geometry import arc_length, interpolate_polyline
-    from curvenet.sketch import Sketch
+    from curvenet.model.sketch import Sketch
     rng = np.random.default_rng(seed)
     ref = shape.reference_mesh(5)
     diag = float(np.linalg.norm(ref.vertices.max(0) - ref.vertices.min(0)))

@@ -26,8 +26,8 @@ from pathlib import Path
 
 import networkx as nx
 
-from curvenet.cycles import find_patches
-from curvenet.shapes import grid_box
+from curvenet.cycles.find import find_patches
+from curvenet.datasets.shapes import grid_box
 
 DATA = Path(os.environ.get("CURVENET_DATA",
                            Path(__file__).resolve().parents[2] / "shared" / "data"))
@@ -64,8 +64,8 @@ def bench_sketch_to_file(sizes, repeats):
     """Sketch OBJ -> PATCHES.json in process (read, snap, find patches, write)."""
     import tempfile
 
-    from curvenet.io import write_sketch
-    from curvenet.patchset import save_patchset
+    from curvenet.io.sketch import write_sketch
+    from curvenet.model.patchset import save_patchset
     from curvenet.pipeline import patches
 
     print(f"\n{'sketch -> PATCHES.json':<24}{'curves':>7}{'patches':>8}{'total s':>9}"
@@ -87,7 +87,7 @@ def bench_sketch_to_file(sizes, repeats):
 
 
 def bench_data(repeats):
-    from curvenet.io import read_network_obj
+    from curvenet.io.sketch import read_network_obj
 
     files = sorted((DATA / "networks").glob("*/*.obj"))
     if not files:

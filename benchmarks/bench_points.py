@@ -26,11 +26,11 @@ from pathlib import Path
 import networkx as nx
 import numpy as np
 
-from curvenet import shapes
-from curvenet.pointcurves import recover_curves
-from curvenet.shapes import sample_curves
-from curvenet.sketch import Sketch
-from curvenet.snap import snap
+from curvenet.datasets import shapes
+from curvenet.io.points import recover_curves
+from curvenet.datasets.shapes import sample_curves
+from curvenet.model.sketch import Sketch
+from curvenet.snap.graph import snap
 
 #: (spacing, RMS noise, density ratio); lengths are fractions of the diagonal.
 CASES = {"uniform": (0.002, 0.0, 1.0), "uneven": (0.004, 0.0025, 3.0),
@@ -49,7 +49,7 @@ def recovered(pts):
 
 
 def large(n_points: int) -> None:
-    from curvenet.io import read_sketch
+    from curvenet.io.sketch import read_sketch
     shape = shapes.torus()
     net = shape.network
     length = sum(e.length() for e in net.edges)
@@ -96,7 +96,7 @@ def rates(seeds: int, names) -> None:
 
 def fscore(names, cases) -> None:
     import curvenet
-    from curvenet.evaluate import evaluate_mesh
+    from curvenet.evaluate.metrics import evaluate_mesh
     print("| shape | case | F true curves | F recovered | difference (points) |")
     print("|---|---|---|---|---|")
     for name in names:

@@ -7,8 +7,8 @@ in a fresh subprocess.
 
 ``python benchmarks/bench_sharpnet.py box [--input rounded|flow|true] [--boundary B]
 [--steps N]`` -- the
-box sketch with its 12 edges labelled ``crease`` (``curvenet.shapes.box``, roughened with
-``curvenet.redraw.rough_sketch`` unless ``--clean``): the crease refinement
+box sketch with its 12 edges labelled ``crease`` (``curvenet.datasets.shapes.box``, roughened with
+``curvenet.datasets.redraw.rough_sketch`` unless ``--clean``): the crease refinement
 (:func:`neural.creases.crease_refine`) with the feature strips against the same fit without
 them (same network, data and steps), normal error against the true box
 (``curvenet.evaluate``: mean angle between normals at closest points, both directions) and
@@ -225,9 +225,9 @@ def _preview(meshes: dict, path: Path) -> None:
 def bench_box(args) -> None:
     import torch
 
-    from curvenet.evaluate import evaluate_mesh
-    from curvenet.redraw import rough_sketch
-    from curvenet.shapes import box
+    from curvenet.evaluate.metrics import evaluate_mesh
+    from curvenet.datasets.redraw import rough_sketch
+    from curvenet.datasets.shapes import box
     from curvenet.neural.creases import crease_refine
 
     torch.set_num_threads(args.threads)

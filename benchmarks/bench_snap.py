@@ -5,7 +5,7 @@ of snapping statistics per public data file instead; ``--recovery --seeds 200 --
 0.04`` the graph-recovery rate per shape on the independent redraws of issue 16).
 Prints one row per case: strokes, points, seconds (best of ``--repeat``), and
 whether the snapped graph matches the clean network it was re-drawn from
-(:func:`curvenet.redraw.match_networks`).
+(:func:`curvenet.datasets.redraw.match_networks`).
 
 The large case is a saddle grid re-drawn rough with every redraw amplitude and
 the snapping tolerance scaled by ``4 / n`` (so each grid cell looks like the
@@ -20,10 +20,10 @@ from pathlib import Path
 
 import numpy as np
 
-from curvenet import shapes
-from curvenet.redraw import match_networks, rough_sketch
-from curvenet.sketch import Sketch
-from curvenet.snap import DEFAULT_SNAP_TOL, snap
+from curvenet.datasets import shapes
+from curvenet.datasets.redraw import match_networks, rough_sketch
+from curvenet.model.sketch import Sketch
+from curvenet.snap.graph import DEFAULT_SNAP_TOL, snap
 
 
 def _resample(stroke, n):
@@ -63,7 +63,7 @@ def data_table(root):
     """One line of snapping statistics per public data file (networks, vns, cassie, stability)."""
     import warnings
 
-    from curvenet.io import read_network_obj, read_sketch
+    from curvenet.io.sketch import read_network_obj, read_sketch
 
     root = Path(root)
     print(f"{'file':44s} {'mode':5s} {'str':>4s} {'V':>5s} {'E':>5s} {'ref V,E':>9s} {'jun':>4s} "
@@ -99,9 +99,9 @@ def patch_table(root, snap_tol=None):
     """Patch count and coverage (curve length on patch edges) per public rough sketch."""
     import warnings
 
-    from curvenet.io import read_sketch
+    from curvenet.io.sketch import read_sketch
     from curvenet.pipeline import patches
-    from curvenet.route import coverage
+    from curvenet.route.decision import coverage
 
     root = Path(root) / "sketches"
     files = (sorted((root / "vns").rglob("*.obj"))
@@ -131,7 +131,7 @@ def big_inputs(folder):
     path). ``scribbles.txt``: 7,000 random smooth strokes of 1,000 points in the unit cube
     (7M points, about 200 MB of text).
     """
-    from curvenet.io import write_sketch
+    from curvenet.io.sketch import write_sketch
     folder = Path(folder)
     rng = np.random.default_rng(0)
     lat = np.linspace(-1.55, 1.55, 4000)[:, None]
@@ -150,7 +150,7 @@ def big_inputs(folder):
 _CHILD = """
 import os, resource, sys, time
 resource.setrlimit(resource.RLIMIT_AS, (int(sys.argv[2]) << 30, int(sys.argv[2]) << 30))
-from curvenet.errors import CurvenetError
+from curvenet.core.errors import CurvenetError
 from curvenet.io import read_sketch
 from curvenet.snap import snap
 t, c = time.perf_counter(), time.process_time()
@@ -263,7 +263,7 @@ def main(argv=None):
     ap.add_argument("--shapes", default=",".join(RECOVERY_SHAPES), help="--recovery: shapes")
     ap.add_argument("--generator", default="redraw2", help="--recovery: the generator: "
                     "redraw2 or redraw3 (function NAME in tests/curvenet/_NAME.py), or "
-                    "rough_sketch (curvenet.redraw)")
+                    "rough_sketch (curvenet.datasets.redraw)")
     ap.add_argument("--jobs", type=int, default=1, help="--recovery: worker processes")
     args = ap.parse_args(argv)
     if args.recovery:

@@ -6,7 +6,7 @@ Prints two tables:
    saddle grids at the default resolution and subdivision, for the direct
    least-squares fit (default), the published iteration (Eq. 3-4) and the soap-film
    baseline; target: 50 patches in under 2 s;
-2. accuracy on the analytic networks of ``curvenet.shapes`` against their true
+2. accuracy on the analytic networks of ``curvenet.datasets.shapes`` against their true
    surfaces (Chamfer, F-score at 0.01, after scaling the longest side to 1), classical
    against soap-film.
 
@@ -24,7 +24,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from curvenet import surfacing  # noqa: E402
-from curvenet import shapes  # noqa: E402
+from curvenet.datasets import shapes  # noqa: E402
 from tests.surfacing._metrics import compare  # noqa: E402
 
 

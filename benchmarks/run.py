@@ -13,8 +13,8 @@ against the true surface where one exists (analytic shapes, longest side scaled
 to 1), and the stroke-to-surface distance (mean and max, fraction of the
 sketch's bounding-box diagonal) everywhere.
 
-Sets: ``analytic`` (clean networks of :mod:`curvenet.shapes`, re-drawn rough with
-:func:`curvenet.redraw.rough_sketch`), ``networks`` (``shared/data/networks``),
+Sets: ``analytic`` (clean networks of :mod:`curvenet.datasets.shapes`, re-drawn rough with
+:func:`curvenet.datasets.redraw.rough_sketch`), ``networks`` (``shared/data/networks``),
 ``vns`` (``shared/data/sketches/vns``). Data is read in place from
 ``$CURVENET_DATA`` (default ``../shared/data``).
 """
@@ -30,9 +30,9 @@ from pathlib import Path
 
 import numpy as np
 
-from curvenet import shapes
-from curvenet.errors import CurvenetError
-from curvenet.evaluate import evaluate_mesh, stroke_distance
+from curvenet.datasets import shapes
+from curvenet.core.errors import CurvenetError
+from curvenet.evaluate.metrics import evaluate_mesh, stroke_distance
 from curvenet.pipeline import SurfaceResult, surface
 
 DATA = Path(os.environ.get("CURVENET_DATA", Path(__file__).resolve().parents[2] / "shared/data"))
@@ -79,7 +79,7 @@ def poisson_baseline(source):
 def inputs(which: str, rough: bool, limit: int | None):
     """Yield ``(name, source, reference_mesh_or_None)``."""
     if which in ("analytic", "all"):
-        from curvenet.redraw import rough_sketch
+        from curvenet.datasets.redraw import rough_sketch
         for name in ANALYTIC:
             s = shapes.SHAPES[name]()
             sk = rough_sketch(s.network, seed=0) if rough else s.sketch()

@@ -1,7 +1,7 @@
 """The ``curvenet`` command: a thin layer over the library.
 
 Parses arguments, calls :mod:`curvenet.pipeline` and friends, and turns a
-:class:`~curvenet.errors.CurvenetError` into one line on stderr and exit code 2
+:class:`~curvenet.core.errors.CurvenetError` into one line on stderr and exit code 2
 (1 for an internal failure, 130 for Ctrl-C); ``--debug`` shows tracebacks.
 """
 
@@ -14,9 +14,9 @@ import sys
 import time
 from pathlib import Path
 
-from ._atomic import check_output_path
+from .core.atomic import check_output_path
 from .core.tolerances import check_snap_tol
-from .errors import CurvenetError, InvalidParameterError, OutputError
+from .core.errors import CurvenetError, InvalidParameterError, OutputError
 
 __all__ = ["main", "build_parser"]
 
@@ -98,7 +98,7 @@ def _points(args):
 
 def build_parser() -> argparse.ArgumentParser:
     from .pipeline import METHODS
-    from .surfacers import get_surfacer, surfacer_names
+    from .route.registry import get_surfacer, surfacer_names
     p = _Parser(prog="curvenet", description="3D sketches and curve networks to surfaces.")
     p.add_argument("--debug", action="store_true", help="show tracebacks on errors")
     sub = p.add_subparsers(dest="command", required=True)
@@ -199,9 +199,9 @@ def build_parser() -> argparse.ArgumentParser:
 
 # --------------------------------------------------------------------------- commands
 def _cmd_snap(args) -> int:
-    from .io import read_sketch, write_network_obj
-    from .patchset import save_network
-    from .snap import snap
+    from .io.sketch import read_sketch, write_network_obj
+    from .model.patchset import save_network
+    from .snap.graph import snap
     check_output_path(args.output, inputs=[args.input], what="-o")
     sketch = read_sketch(args.input, points=_points(args))
     net = snap(sketch, snap_tol=args.snap_tol)
@@ -220,21 +220,21 @@ def _cmd_snap(args) -> int:
 
 
 def _cmd_patches(args) -> int:
-    from .patchset import save_patchset
+    from .model.patchset import save_patchset
     from .pipeline import patches
     check_output_path(args.output, inputs=[args.input], what="-o")
     if args.preview:
         check_output_path(args.preview, inputs=[args.input, args.output], what="--preview")
     ps = patches(args.input, snap_tol=args.snap_tol, close=args.close, points=_points(args))
     if args.interactive:
-        from .session import run_interactive
+        from .cycles.session import run_interactive
         ps = run_interactive(ps, input=sys.stdin, output=sys.stdout, preview=args.preview)
     save_patchset(args.output, ps)
     t = ps.report.get("timings", {})
     print(f"{args.output}: {len(ps.patches)} patches on {ps.network.number_of_edges} curves "
           f"({sum(t.values()):.2f} s)")
     if args.preview:
-        from .preview import render_preview
+        from .view.preview import render_preview
         render_preview(args.preview, network=ps.network, patches=ps, title=Path(args.input).name,
                        up=args.up)
     return 0
@@ -250,7 +250,7 @@ def _neural_options(args) -> dict | None:
 
 def _surface_one(inp: str, out: str, args) -> dict:
     """Surface one input; returns a status row (never raises CurvenetError)."""
-    from .patchset import load_network_file
+    from .model.patchset import load_network_file
     from .pipeline import surface
     t0 = time.perf_counter()
     try:
@@ -264,7 +264,7 @@ def _surface_one(inp: str, out: str, args) -> dict:
                       neural_options=_neural_options(args), points=_points(args))
         res.save(out, schema=args.step_schema)
         if args.preview:
-            from .preview import render_preview
+            from .view.preview import render_preview
             prev = args.preview if args.output else str(Path(out).with_suffix(".png"))
             render_preview(prev, strokes=res.sketch, network=res.network, mesh=res.mesh,
                            title=f"{Path(inp).name}: {res.method}", up=args.up,
@@ -311,7 +311,7 @@ _SEAMS_SHOWN = 10
 
 
 def _cmd_surface(args) -> int:
-    from .cad import require_cad
+    from .cad.export import require_cad
     from .pipeline import CAD_FORMATS, MESH_FORMATS
     suffix = (Path(args.output).suffix.lower() if args.out_dir is None and args.output
               else "." + args.format)
@@ -348,7 +348,7 @@ def _cmd_surface(args) -> int:
         for line in row.get("regions", []):
             print(f"  region {line}")
         if row.get("fidelity"):
-            from .evaluate import format_fidelity
+            from .evaluate.metrics import format_fidelity
             print(format_fidelity(row["fidelity"]))
         if row.get("cad"):
             print("\n".join(_cad_lines(row["cad"])))
@@ -356,7 +356,7 @@ def _cmd_surface(args) -> int:
 
 
 def _batch_options(args):
-    from .batch import BatchOptions
+    from .batch.run import BatchOptions
     return BatchOptions(method=args.method, snap_tol=args.snap_tol, close=args.close,
                         surfacer=args.surfacer, subdiv=args.subdiv, resolution=args.resolution,
                         crease_angle=args.crease_angle, edge_length=args.edge_length,
@@ -376,8 +376,8 @@ def _progress(total: int, quiet: bool):
 
 def _cmd_surface_batch(args) -> int:
     """``--out-dir``: the batch engine (:mod:`curvenet.batch`), one line per file."""
-    from .batch import DaskExecutor, LocalExecutor, run_batch
-    from .tables import check_report_path, write_table
+    from .batch.run import DaskExecutor, LocalExecutor, run_batch
+    from .io.tables import check_report_path, write_table
     if args.output is not None:
         raise InvalidParameterError("surface: give -o MESH or --out-dir DIR, not both")
     if args.patches is not None:
@@ -430,8 +430,8 @@ def _batch_line(row: dict, done: int, total: int, explain: bool) -> str:
 
 def _cmd_eval_pairs(args) -> int:
     """``eval --pairs``: a table over many pairs, metric definitions in the report header."""
-    from . import batch_eval as be
-    from .tables import check_report_path, write_table
+    from .evaluate import pairs as be
+    from .io.tables import check_report_path, write_table
     if args.mesh is not None:
         raise InvalidParameterError("eval: give MESH REFERENCE or --pairs, not both")
     report = None if args.report is None else check_report_path(args.report,
@@ -464,8 +464,8 @@ def _cmd_eval_pairs(args) -> int:
 
 
 def _cmd_eval(args) -> int:
-    from .batch_eval import is_mesh_file
-    from .evaluate import evaluate_mesh, format_report, stroke_distance
+    from .evaluate.pairs import is_mesh_file
+    from .evaluate.metrics import evaluate_mesh, format_report, stroke_distance
     if args.pairs is not None:
         return _cmd_eval_pairs(args)
     if args.mesh is None or args.reference is None:
@@ -475,9 +475,9 @@ def _cmd_eval(args) -> int:
         metrics = evaluate_mesh(args.mesh, args.reference, n_samples=args.samples,
                                 threshold=args.threshold, seed=args.seed)
     else:
-        from .evaluate import sketch_fidelity
-        from .io import read_sketch
-        from .routed import read_obj_wires
+        from .evaluate.metrics import sketch_fidelity
+        from .io.sketch import read_sketch
+        from .io.meshes import read_obj_wires
         sketch = read_sketch(ref)
         metrics = stroke_distance(args.mesh, sketch)
         wires = read_obj_wires(args.mesh) if str(args.mesh).lower().endswith(".obj") else []

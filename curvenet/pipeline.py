@@ -5,7 +5,7 @@ patch route (Coons -> Catmull-Clark limit fit, :mod:`surfacing`) or the neural
 route (flow-aligned implicit, :mod:`neural`) serves the sketch better, and says
 why in ``SurfaceResult.decision`` (a :class:`~curvenet.route.RouteDecision`; its
 sentence is ``SurfaceResult.diagnostics["decision"]``). The surfacers themselves
-come from the registry of :mod:`curvenet.surfacers`.
+come from the registry of :mod:`curvenet.route.registry`.
 """
 
 from __future__ import annotations
@@ -16,15 +16,15 @@ from pathlib import Path
 
 import numpy as np
 
-from ._atomic import atomic_path
-from .cad import CAD_FORMATS
+from .core.atomic import atomic_path
+from .cad.export import CAD_FORMATS
 from .core.result import MeshResult
-from .errors import CurvenetError, InvalidParameterError, SketchFormatError
-from .network import CurveNetwork
-from .patchset import PatchSet, load_network_file
-from .route import AUTO_MIN_COVERAGE, RouteDecision, coverage, region_route
-from .sketch import Sketch
-from .surfacers import (SurfaceInput, SurfaceSettings, Surfacer, get_surfacer,
+from .core.errors import CurvenetError, InvalidParameterError, SketchFormatError
+from .model.network import CurveNetwork
+from .model.patchset import PatchSet, load_network_file
+from .route.decision import AUTO_MIN_COVERAGE, RouteDecision, coverage, region_route
+from .model.sketch import Sketch
+from .route.registry import (SurfaceInput, SurfaceSettings, Surfacer, get_surfacer,
                         surfacer_names)
 
 __all__ = ["SurfaceResult", "surface", "patches", "load_source", "MESH_FORMATS", "CAD_FORMATS",
@@ -64,7 +64,7 @@ class SurfaceResult:
     wires : list of (m, 3) float64
         Stretches of strokes the surface does not pass through (strokes that bound
         nothing, trimmed overshoots, overdrawn strokes), with the strokes' own geometry,
-        kept as polylines beside the mesh (``auto`` only; :func:`curvenet.hybrid.add_wires`).
+        kept as polylines beside the mesh (``auto`` only; :func:`curvenet.route.hybrid.add_wires`).
     face_route : (F,) uint8 or None
         Per face, an index into ``routes``: the route that made it.
     routes : tuple of str
@@ -98,7 +98,7 @@ class SurfaceResult:
         """Write the mesh atomically; the format follows the extension.
 
         With wires or several routes, OBJ gets one group per route and the wires as
-        ``l`` records, PLY a ``route`` face property (:func:`curvenet.routed.write_routed`).
+        ``l`` records, PLY a ``route`` face property (:func:`curvenet.io.meshes.write_routed`).
         ``.step`` / ``.stp`` (``schema`` AP214 or AP242) and ``.3dm`` write B-spline
         faces (:func:`export_cad`, needs ``pip install 'curvenet[cad]'``).
         """
@@ -107,7 +107,7 @@ class SurfaceResult:
             return Path(path)
         if not self.wires and len(self.routes) < 2:
             return write_mesh(path, self.mesh)
-        from .routed import write_routed
+        from .io.meshes import write_routed
         _check_format(path)
         return write_routed(path, self.mesh, self.face_route, self.routes, self.wires)
 
@@ -192,7 +192,7 @@ def load_source(source, *, points="auto"):
     """
     if isinstance(source, Sketch):
         if points is True:
-            from .pointcurves import read_point_blocks
+            from .io.points import read_point_blocks
             return read_point_blocks(source, True), None
         return source, None
     if isinstance(source, PatchSet):
@@ -204,14 +204,14 @@ def load_source(source, *, points="auto"):
         raise SketchFormatError("no such file", path=path)
     if _is_network_json(path):
         return None, load_network_file(path)
-    from .io import read_sketch
+    from .io.sketch import read_sketch
     return read_sketch(path, points=points), None
 
 
 def _network(sketch, patchset, *, snap_tol, timings):
     if patchset is not None:
         return patchset.network
-    from .snap import snap
+    from .snap.graph import snap
     t = time.perf_counter()
     net = snap(sketch, snap_tol=snap_tol)
     timings["snap"] = time.perf_counter() - t
@@ -252,7 +252,7 @@ def patches(source, *, snap_tol: float | str | None = "auto", close: str = "auto
     >>> len(ps.patches)
     6
     """
-    from .cycles import find_patches
+    from .cycles.find import find_patches
     sketch, given = load_source(source, points=points)
     timings: dict = {}
     net = _network(sketch, given, snap_tol=snap_tol, timings=timings)
@@ -355,7 +355,7 @@ def _plan(method: str, surfacer: str, refine: bool, settings: SurfaceSettings, *
 
 def _find_patches(sketch, given, *, snap_tol, close, timings, diag):
     """Snap (unless given a network) and find patches (unless given some)."""
-    from .cycles import find_patches
+    from .cycles.find import find_patches
     net = _network(sketch, given, snap_tol=snap_tol, timings=timings)
     diag["snap"] = dict(net.report)
     if given is not None and given.patches:
@@ -372,7 +372,7 @@ def _find_patches(sketch, given, *, snap_tol, close, timings, diag):
 def _decide(method: str, plan: _Plan, diag: dict, ps) -> RouteDecision:
     """The route: auto's rule per region, or what was requested (with the coverage)."""
     if method == "auto":
-        from .hybrid import plan_regions
+        from .route.hybrid import plan_regions
         curves = [e.curve for e in ps.network.edges]
         used = np.zeros(len(curves), bool)
         used[sorted({i for p in ps.patches for i in p.edges})] = True
@@ -414,7 +414,7 @@ def _surface_route(plan: _Plan, decision: RouteDecision, settings: SurfaceSettin
     """Run the decided surfacer (and the refinement); returns ``(MeshResult, name)``."""
     res, name, init = None, None, None
     if _classical(plan, decision):
-        from .loops import orient_boundaries
+        from .cycles.loops import orient_boundaries
         edges = net.edges
         bounds = orient_boundaries(net, ps.patches)
         inp = SurfaceInput(settings, curves=[e.curve for e in edges],
@@ -512,10 +512,10 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
     out = SurfaceResult(res.to_trimesh(), name, sketch, net, ps, timings, diag, decision,
                         control_net=getattr(res, "control_net", None))
     if decision.regions:
-        from .hybrid import assemble
+        from .route.hybrid import assemble
         assemble(out, res, plan, settings, _run)
     if method == "auto":
-        from .hybrid import add_wires
+        from .route.hybrid import add_wires
         add_wires(out)
     _fidelity(out)
     return out
@@ -523,7 +523,7 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
 
 def _fidelity(res: SurfaceResult) -> None:
     """``diagnostics["fidelity"]``: :func:`curvenet.evaluate.sketch_fidelity` of the result."""
-    from .evaluate import sketch_fidelity
+    from .evaluate.metrics import sketch_fidelity
     t = time.perf_counter()
     ref = res.sketch if res.sketch is not None else res.network
     res.diagnostics["fidelity"] = sketch_fidelity(res.mesh, ref, wires=res.wires)

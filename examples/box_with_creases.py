@@ -6,7 +6,7 @@ Writes ``out/box.obj`` and ``out/box.png``. Run: ``python examples/box_with_crea
 from pathlib import Path
 
 import curvenet
-from curvenet.preview import render_preview
+from curvenet.view.preview import render_preview
 
 HERE = Path(__file__).resolve().parent
 OUT = Path("out")

@@ -8,7 +8,7 @@ runs: pass ``device="cuda"``).
 from pathlib import Path
 
 import curvenet
-from curvenet.preview import render_preview
+from curvenet.view.preview import render_preview
 
 HERE = Path(__file__).resolve().parent
 OUT = Path("out")

@@ -7,7 +7,7 @@ Run: ``python examples/ellipsoid_patches.py``.
 from pathlib import Path
 
 import curvenet
-from curvenet.preview import render_preview
+from curvenet.view.preview import render_preview
 
 HERE = Path(__file__).resolve().parent
 OUT = Path("out")

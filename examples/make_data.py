@@ -1,7 +1,7 @@
 """Regenerate the bundled example sketches in ``examples/data/``.
 
 They are drawn here, by curvenet's own generators: clean analytic networks
-(:mod:`curvenet.shapes`) re-drawn rough (:func:`curvenet.redraw.rough_sketch`),
+(:mod:`curvenet.datasets.shapes`) re-drawn rough (:func:`curvenet.datasets.redraw.rough_sketch`),
 and a set of disjoint cross-section strokes that form no cycles. Run::
 
     python examples/make_data.py
@@ -11,9 +11,10 @@ from pathlib import Path
 
 import numpy as np
 
-from curvenet import Sketch, shapes
-from curvenet.io import write_sketch
-from curvenet.redraw import rough_sketch
+from curvenet import Sketch
+from curvenet.datasets import shapes
+from curvenet.io.sketch import write_sketch
+from curvenet.datasets.redraw import rough_sketch
 
 HERE = Path(__file__).resolve().parent / "data"
 

@@ -739,8 +739,8 @@ def _polished(fit: _FlowFit, f, mesh, strokes, labels, cut_boundary):
 
 def _fidelity(V, F, strokes) -> float:
     """Stroke fidelity of the mesh ``(V, F)`` (0 when it has no triangle of positive area)."""
-    from curvenet.errors import InvalidParameterError
-    from curvenet.evaluate import sketch_fidelity
+    from curvenet.core.errors import InvalidParameterError
+    from curvenet.evaluate.metrics import sketch_fidelity
     try:
         return sketch_fidelity((V, F), strokes)["surface"]
     except InvalidParameterError:          # no faces, or only degenerate ones

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from curvenet.core.result import MeshResult
-from curvenet.errors import InvalidParameterError
+from curvenet.core.errors import InvalidParameterError
 
 from .bspline import ControlNet
 from .catmull_clark import edge_index, subdivision_step

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from curvenet.errors import InvalidParameterError
+from .errors import InvalidParameterError
 
 from .tolerances import DIVISION_GUARD, ZERO_LENGTH
 

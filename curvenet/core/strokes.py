@@ -8,7 +8,7 @@ the surface passes through), ``"crease"`` (the same, with a sharp edge) and
 
 from __future__ import annotations
 
-from curvenet.errors import InvalidParameterError
+from .errors import InvalidParameterError
 
 from .geometry import as_polyline
 

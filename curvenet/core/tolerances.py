@@ -23,7 +23,7 @@ from __future__ import annotations
 import math
 import numbers
 
-from curvenet.errors import InvalidParameterError
+from .errors import InvalidParameterError
 
 __all__ = [
     "DIVISION_GUARD",

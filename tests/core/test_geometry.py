@@ -14,7 +14,7 @@ from curvenet.core import (LABELS, arc_length, arc_length_params, as_polyline, b
                            face_normals_areas, interpolate_polyline, resample_polyline,
                            sample_at, sample_surface)
 from curvenet.core.tolerances import SNAP_TOL_RANGE, check_snap_tol
-from curvenet.errors import CurvenetError, InvalidParameterError
+from curvenet.core.errors import CurvenetError, InvalidParameterError
 
 CORE = Path(__file__).resolve().parents[2] / "curvenet" / "core"
 
@@ -222,7 +222,7 @@ def test_core_imports_no_torch_and_no_other_curvenet_module():
             else:
                 continue
             for name in names:
-                ok = name == "curvenet.errors" or name.split(".")[0] not in ("torch", "curvenet")
+                ok = name == "curvenet.core.errors" or name.split(".")[0] not in ("torch", "curvenet")
                 assert ok, f"{path.name} imports {name}"
 
 

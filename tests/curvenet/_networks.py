@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from curvenet.network import CurveNetwork
+from curvenet.model.network import CurveNetwork
 
 
 def random_network(seed, n=9, m=16, *, loops=True, parallel=True) -> CurveNetwork:

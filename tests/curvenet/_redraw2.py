@@ -1,7 +1,7 @@
-"""A second rough-redraw generator, independent of :mod:`curvenet.redraw` (issue 16).
+"""A second rough-redraw generator, independent of :mod:`curvenet.datasets.redraw` (issue 16).
 
 Written from scratch with a different noise model, to test that snapping holds
-on noise it was not tuned to. Where :func:`curvenet.redraw.rough_sketch` draws
+on noise it was not tuned to. Where :func:`curvenet.datasets.redraw.rough_sketch` draws
 every network edge as its own stroke, this one draws the way people sketch:
 
 * **Chains through junctions.** At every vertex the incident curve ends are
@@ -29,7 +29,7 @@ every network edge as its own stroke, this one draws the way people sketch:
 
 :func:`graph_recovered` is the oracle: the snapped network's multigraph (loops
 and parallel edges included) is isomorphic to the true one, and its curves
-match the true curves one to one (:func:`curvenet.redraw.match_networks`).
+match the true curves one to one (:func:`curvenet.datasets.redraw.match_networks`).
 """
 
 from __future__ import annotations
@@ -38,8 +38,8 @@ import networkx as nx
 import numpy as np
 from scipy.ndimage import gaussian_filter1d
 
-from curvenet.redraw import match_networks
-from curvenet.sketch import Sketch
+from curvenet.datasets.redraw import match_networks
+from curvenet.model.sketch import Sketch
 
 
 def _arclen(c):

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from curvenet.sketch import Sketch
+from curvenet.model.sketch import Sketch
 
 from ._redraw2 import _along, _arclen, _leaving
 

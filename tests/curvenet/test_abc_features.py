@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 import yaml
 
-from curvenet.abc_features import read_abc_features
+from curvenet.io.abc import read_abc_features
 from curvenet.cli import main
-from curvenet.errors import SketchFormatError
-from curvenet.io import detect_format, read_sketch, write_sketch
+from curvenet.core.errors import SketchFormatError
+from curvenet.io.sketch import detect_format, read_sketch, write_sketch
 
 TAU = 2 * np.pi
 

@@ -1,4 +1,4 @@
-"""Tests of curvenet.basis: the greedy basis against a brute-force greedy (Theorem 1).
+"""Tests of curvenet.cycles.basis: the greedy basis against a brute-force greedy (Theorem 1).
 
 Oracle: a greedy over every simple cycle of small graphs (networkx), ranked by
 galois; the cycle-rank formula E - V + C.
@@ -9,11 +9,11 @@ from __future__ import annotations
 import networkx as nx
 import pytest
 
-from curvenet._gf2 import edge_mask, gf2_rank
-from curvenet.basis import greedy_basis
-from curvenet.candidates import SEPARATING_EPS, CandidatePool
-from curvenet.cycles import find_patches
-from curvenet.network import CurveNetwork
+from curvenet.cycles.gf2 import edge_mask, gf2_rank
+from curvenet.cycles.basis import greedy_basis
+from curvenet.cycles.candidates import SEPARATING_EPS, CandidatePool
+from curvenet.cycles.find import find_patches
+from curvenet.model.network import CurveNetwork
 
 from ._networks import random_network, random_simple_network
 

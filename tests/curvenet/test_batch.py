@@ -15,12 +15,12 @@ import numpy as np
 import pytest
 import trimesh
 
-from curvenet import shapes
-from curvenet.batch import MANIFEST_NAME, BatchOptions, plan_outputs, read_manifest, run_batch
+from curvenet.datasets import shapes
+from curvenet.batch.run import MANIFEST_NAME, BatchOptions, plan_outputs, read_manifest, run_batch
 from curvenet.cli import main
-from curvenet.errors import InvalidParameterError
-from curvenet.evaluate import stroke_fidelity
-from curvenet.io import write_sketch
+from curvenet.core.errors import InvalidParameterError
+from curvenet.evaluate.metrics import stroke_fidelity
+from curvenet.io.sketch import write_sketch
 
 
 def _boxes(folder, n):
@@ -134,7 +134,7 @@ def test_report_rows_and_contact_sheet(tmp_path):
     assert res.rows[4]["status"] == "error" and "bad.obj:1" in res.rows[4]["error"]
     from matplotlib.image import imread
 
-    from curvenet.contact_sheet import ROUTE_COLOURS
+    from curvenet.view.contact_sheet import ROUTE_COLOURS
     img = imread(tmp_path / "prev" / "contact_sheet.png")[..., :3]
     for key in ("classical", "failed"):
         rgb = np.array([int(ROUTE_COLOURS[key][i:i + 2], 16) / 255 for i in (1, 3, 5)])
@@ -150,16 +150,16 @@ def _crashing_task(path, data, options, **kw):
     return _REAL_TASK(path, data, options, **kw)
 
 
-_REAL_TASK = __import__("curvenet.batch").batch.surface_task
+_REAL_TASK = __import__("curvenet.batch.run").batch.run.surface_task
 
 
 @pytest.mark.skipif(__import__("multiprocessing").get_start_method() != "fork",
                     reason="the crash is injected into forked pool processes")
 def test_a_pool_process_that_dies_costs_only_its_own_file(tmp_path, monkeypatch):
-    import curvenet.batch
-    from curvenet.batch import LocalExecutor
+    import curvenet.batch.run
+    from curvenet.batch.run import LocalExecutor
     inputs = _shapes(tmp_path / "in") + _boxes(tmp_path / "in", 2)
-    monkeypatch.setattr(curvenet.batch, "surface_task", _crashing_task)
+    monkeypatch.setattr(curvenet.batch.run, "surface_task", _crashing_task)
     res = run_batch(inputs, tmp_path / "out", BatchOptions(method="classical"),
                     executor=LocalExecutor(2))
     status = {os.path.basename(r["input"]): r["status"] for r in res.rows}
@@ -262,7 +262,7 @@ def test_a_task_whose_worker_dies_for_good_is_reported_and_the_rest_goes_on(tmp_
             distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=True,
                                      dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
-        from curvenet.batch import DaskExecutor
+        from curvenet.batch.run import DaskExecutor
         victim = next(iter(client.run(os.getpid).values()))
         killed = []
 

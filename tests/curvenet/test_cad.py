@@ -5,9 +5,9 @@ import sys
 import numpy as np
 import pytest
 
-from curvenet import shapes
+from curvenet.datasets import shapes
 from curvenet.cli import main
-from curvenet.patchset import save_network
+from curvenet.model.patchset import save_network
 from curvenet.pipeline import surface
 
 
@@ -25,7 +25,7 @@ def test_cad_format_without_the_extra_names_it(monkeypatch, tmp_path, capsys):
 
 def test_neural_or_soapfilm_result_refuses_cad(tmp_path):
     pytest.importorskip("OCP")
-    from curvenet.errors import InvalidParameterError
+    from curvenet.core.errors import InvalidParameterError
     res = surface(shapes.box().sketch(), method="classical", surfacer="soapfilm")
     with pytest.raises(InvalidParameterError, match="classical Catmull-Clark"):
         res.save(tmp_path / "x.step")
@@ -33,7 +33,7 @@ def test_neural_or_soapfilm_result_refuses_cad(tmp_path):
 
 def test_hybrid_result_with_neural_faces_refuses_cad_in_one_line(tmp_path, capsys):
     pytest.importorskip("OCP")
-    from curvenet.errors import InvalidParameterError
+    from curvenet.core.errors import InvalidParameterError
     res = surface(shapes.box().sketch(), method="classical")
     n = len(res.mesh.faces)
     res.routes, res.face_route = ("classical", "neural"), (np.arange(n) >= n - 5).astype(np.uint8)
@@ -157,7 +157,7 @@ def test_flat_faces_with_holes_refuse_cad_in_one_line(tmp_path):
     """A washer's annular faces are flat: meshed in their plane over a control mesh of
     the outer loop only, so a B-spline face would fill the hole: refused, no file."""
     pytest.importorskip("OCP")
-    from curvenet.errors import InvalidParameterError
+    from curvenet.core.errors import InvalidParameterError
     res = surface(shapes.washer().sketch(), method="classical")
     with pytest.raises(InvalidParameterError, match="2 faces with holes") as err:
         res.save(tmp_path / "w.step")

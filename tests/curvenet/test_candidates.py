@@ -1,4 +1,4 @@
-"""Tests of curvenet.candidates: cycle enumeration against networkx, the pool's record.
+"""Tests of curvenet.cycles.candidates: cycle enumeration against networkx, the pool's record.
 
 Oracles: networkx (simple cycles), the python search against the numba kernel.
 """
@@ -9,10 +9,10 @@ import networkx as nx
 import numpy as np
 import pytest
 
-from curvenet import shapes
-from curvenet.candidates import CandidatePool
-from curvenet.cycles import find_patches
-from curvenet.network import CurveNetwork
+from curvenet.datasets import shapes
+from curvenet.cycles.candidates import CandidatePool
+from curvenet.cycles.find import find_patches
+from curvenet.model.network import CurveNetwork
 
 from ._networks import found, random_simple_network
 

@@ -10,9 +10,9 @@ import numpy as np
 import pytest
 import trimesh
 
-from curvenet import shapes
+from curvenet.datasets import shapes
 from curvenet.cli import main
-from curvenet.io import write_sketch
+from curvenet.io.sketch import write_sketch
 
 
 def run(*argv):
@@ -159,7 +159,7 @@ def test_out_of_range_neural_setting_names_it(tmp_path, box_obj, capsys):
 def test_snap_and_explain_print_the_snapping_line(tmp_path):
     """`snap` prints one line on what snapping did; `--snap-tol auto` is the default,
     a number overrides it; `surface --explain` shows the same line."""
-    from curvenet.redraw import rough_sketch
+    from curvenet.datasets.redraw import rough_sketch
     rough = tmp_path / "rough.obj"
     write_sketch(rough, rough_sketch(shapes.box().network, seed=0))
     r = run("snap", rough, "-o", tmp_path / "n.json")

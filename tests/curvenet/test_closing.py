@@ -1,4 +1,4 @@
-"""Tests of curvenet.closing: closing suggestions and auto-closing (Sec. 5).
+"""Tests of curvenet.cycles.closing: closing suggestions and auto-closing (Sec. 5).
 
 Oracles: the analytic solids, whose cycle basis misses exactly one true face
 (the faces of a closed surface sum to zero over GF(2)); the hand-computed
@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import pytest
 
-from curvenet import shapes
-from curvenet.candidates import CandidatePool
-from curvenet.closing import auto_close, closing_suggestions
-from curvenet.cycles import find_patches
+from curvenet.datasets import shapes
+from curvenet.cycles.candidates import CandidatePool
+from curvenet.cycles.closing import auto_close, closing_suggestions
+from curvenet.cycles.find import find_patches
 
 from ._networks import found, true_faces
 

@@ -12,11 +12,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from curvenet import shapes
-from curvenet._gf2 import edge_mask, gf2_rank
-from curvenet.cycles import cycle_to_loop, find_patches
-from curvenet.errors import InvalidParameterError
-from curvenet.network import CurveNetwork
+from curvenet.datasets import shapes
+from curvenet.cycles.gf2 import edge_mask, gf2_rank
+from curvenet.cycles.find import cycle_to_loop, find_patches
+from curvenet.core.errors import InvalidParameterError
+from curvenet.model.network import CurveNetwork
 
 from ._networks import found, permuted, random_network, true_faces
 
@@ -138,7 +138,7 @@ def test_invalid_parameters(kwargs):
 
 # --------------------------------------------------------------------------- public data
 def test_runs_on_public_networks(data_dir):
-    from curvenet.io import read_network_obj
+    from curvenet.io.sketch import read_network_obj
 
     files = sorted((data_dir / "networks").glob("*/*.obj"))
     if not files:

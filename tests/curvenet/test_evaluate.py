@@ -9,8 +9,8 @@ import pytest
 import trimesh
 from scipy.spatial import cKDTree
 
-from curvenet.errors import InvalidParameterError, SketchFormatError
-from curvenet.evaluate import (evaluate_mesh, format_report, load_mesh_arrays,
+from curvenet.core.errors import InvalidParameterError, SketchFormatError
+from curvenet.evaluate.metrics import (evaluate_mesh, format_report, load_mesh_arrays,
                                sample_surface, stroke_distance)
 
 
@@ -235,7 +235,7 @@ def test_stroke_distance_oracles():
 
 
 def test_stroke_distance_on_analytic_shape():
-    from curvenet.shapes import box
+    from curvenet.datasets.shapes import box
 
     shape = box()
     d = stroke_distance(shape.reference_mesh(), shape.sketch())

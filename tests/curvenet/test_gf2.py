@@ -1,11 +1,11 @@
-"""Tests of curvenet._gf2 against galois (GF(2) rank and solves)."""
+"""Tests of curvenet.cycles.gf2 against galois (GF(2) rank and solves)."""
 
 from __future__ import annotations
 
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from curvenet._gf2 import (GF2Eliminator, bitset_solve, edge_mask, gf2_rank, gf2_solve,
+from curvenet.cycles.gf2 import (GF2Eliminator, bitset_solve, edge_mask, gf2_rank, gf2_solve,
                            mask_edges)
 
 

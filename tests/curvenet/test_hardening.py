@@ -20,10 +20,10 @@ import numpy as np
 import pytest
 import trimesh
 
-from curvenet import shapes
+from curvenet.datasets import shapes
 from curvenet.cli import _terminate, main
 from curvenet.core.progress import PlainProgress, progress_bar
-from curvenet.io import write_sketch
+from curvenet.io.sketch import write_sketch
 
 
 @pytest.fixture
@@ -135,7 +135,7 @@ def test_hostile_json_is_bad_input(tmp_path, capsys, content, needle):
 
 
 def test_unreadable_input_is_bad_input(tmp_path, box_obj, capsys, monkeypatch):
-    import curvenet._io_common as cio  # the module that opens sketch files
+    import curvenet.io.common as cio  # the module that opens sketch files
 
     def denied(path, *args, **kwargs):
         raise PermissionError(13, "Permission denied", str(path))
@@ -151,7 +151,7 @@ def test_endless_device_is_refused_with_a_bounded_read(tmp_path, capsys):
 
 
 def test_unwritable_folder_names_the_requested_file(tmp_path, box_obj, capsys, monkeypatch):
-    import curvenet._atomic as atomic
+    import curvenet.core.atomic as atomic
 
     def denied(*args, **kwargs):
         raise PermissionError(13, "Permission denied")
@@ -237,7 +237,7 @@ def test_sigterm_while_writing_leaves_no_temporary_file(tmp_path, box_obj):
 
 
 def test_terminate_handler_unwinds_atomic_writes(tmp_path):
-    from curvenet._atomic import atomic_path
+    from curvenet.core.atomic import atomic_path
     with pytest.raises(SystemExit):
         with atomic_path(tmp_path / "x.obj") as tmp:
             tmp.write_text("half")
@@ -287,7 +287,7 @@ def test_strokes_that_collapse_are_an_error_not_an_empty_network(tmp_path, capsy
 
 
 def test_dropped_one_point_strokes_give_one_warning(tmp_path):
-    from curvenet.io import read_sketch
+    from curvenet.io.sketch import read_sketch
     path = tmp_path / "ones.json"
     strokes = [[[0, 0, 0], [1, 0, 0]]] + [[[i, 1.0, 0]] for i in range(1000)]
     path.write_text(json.dumps({"format": "curvenet.sketch", "strokes": strokes}))

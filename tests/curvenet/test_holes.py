@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 import trimesh
 
-from curvenet import shapes
-from curvenet.cycles import find_patches
-from curvenet.holes import hole_patches
-from curvenet.loops import signed_volume
-from curvenet.patchset import Patch, PatchSet, load_network_file, save_patchset
+from curvenet.datasets import shapes
+from curvenet.cycles.find import find_patches
+from curvenet.cycles.holes import hole_patches
+from curvenet.cycles.loops import signed_volume
+from curvenet.model.patchset import Patch, PatchSet, load_network_file, save_patchset
 
 CAD = sorted(shapes.CAD_SHAPES)
 
@@ -85,7 +85,7 @@ def test_hole_detection_off_keeps_simple_cycles():
 
 def test_a_disc_drawn_inside_a_face_is_kept():
     """A circle inside a square with nothing attached: the square gets a hole, the disc stays."""
-    from curvenet.network import CurveNetwork
+    from curvenet.model.network import CurveNetwork
     net = CurveNetwork(np.zeros((0, 3)))
     sq = [net.add_vertex(p) for p in ([0, 0, 0], [2, 0, 0], [2, 2, 0], [0, 2, 0])]
     t = np.linspace(0, 1, 17)[:, None]
@@ -110,7 +110,7 @@ def test_a_disc_drawn_inside_a_face_is_kept():
 def test_a_loop_on_a_sheet_where_surfaces_meet_stays_a_disc():
     """The square shares a side with two more patches (a fin where three surfaces meet):
     it is a sheet, not a solid's face, so the circle on it (a fin base) is no hole."""
-    from curvenet.network import CurveNetwork
+    from curvenet.model.network import CurveNetwork
     net = CurveNetwork(np.zeros((0, 3)))
     sq = [net.add_vertex(p) for p in ([0, 0, 0], [2, 0, 0], [2, 2, 0], [0, 2, 0])]
     t = np.linspace(0, 1, 17)[:, None]
@@ -168,7 +168,7 @@ def _classical(s):
 
 @pytest.mark.parametrize("name", CAD)
 def test_cad_classical_fscore(name):
-    from curvenet.evaluate import evaluate_mesh
+    from curvenet.evaluate.metrics import evaluate_mesh
     s = shapes.CAD_SHAPES[name]()
     res = _classical(s)
     assert evaluate_mesh(res.mesh, s.reference_mesh(4), n_samples=30_000)["fscore"] >= 0.99
@@ -177,7 +177,7 @@ def test_cad_classical_fscore(name):
 @pytest.mark.parametrize("name", CAD)
 def test_cad_flat_faces_are_flat(name):
     """Every output vertex of a planar face lies in its plane to 1e-6 of the diagonal."""
-    from curvenet.loops import orient_boundaries
+    from curvenet.cycles.loops import orient_boundaries
     from curvenet.surfacing.holes import surface_boundaries
     s = shapes.CAD_SHAPES[name]()
     net = s.network

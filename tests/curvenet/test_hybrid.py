@@ -4,12 +4,12 @@ import numpy as np
 import pytest
 
 import curvenet
-from curvenet import shapes
+from curvenet.datasets import shapes
 from curvenet.cli import main
-from curvenet.evaluate import sketch_fidelity
-from curvenet.hybrid import plan_regions
-from curvenet.routed import read_obj_wires
-from curvenet.sketch import Sketch
+from curvenet.evaluate.metrics import sketch_fidelity
+from curvenet.route.hybrid import plan_regions
+from curvenet.io.meshes import read_obj_wires
+from curvenet.model.sketch import Sketch
 
 T = np.linspace(0, 1, 40)
 
@@ -92,7 +92,7 @@ def test_flower_patches_petals_and_leaves_and_keeps_the_stem_as_a_wire(tmp_path)
 def test_eval_counts_wires_of_the_obj(tmp_path, capsys):
     res = curvenet.surface(_flower())
     res.save(tmp_path / "f.obj")
-    from curvenet.io import write_sketch
+    from curvenet.io.sketch import write_sketch
     write_sketch(tmp_path / "f_sketch.obj", res.sketch)
     assert main(["eval", str(tmp_path / "f.obj"), str(tmp_path / "f_sketch.obj"),
                  "--json"]) == 0
@@ -130,7 +130,7 @@ def test_box_with_a_loose_ribbon_gets_a_neural_fill_and_a_wire(tmp_path):
 def test_a_small_surface_like_region_stays_wires():
     # beside a large patched part, a ribbon carrying under MIN_FILL_LENGTH of the curve
     # length is not worth a neural fit
-    from curvenet.hybrid import MIN_FILL_LENGTH, plan_regions
+    from curvenet.route.hybrid import MIN_FILL_LENGTH, plan_regions
     t = np.linspace(0, 1, 20)[:, None]
     ribbon = [np.hstack([t, 0 * t + y, 0 * t]) for y in np.linspace(0, 0.5, 11)]
     length = sum(float(np.linalg.norm(np.diff(c, axis=0), axis=1).sum()) for c in ribbon)
@@ -147,8 +147,8 @@ def _box_mesh():
 
 
 def test_stroke_wires_are_the_strokes_own_stretches_off_the_surface():
-    from curvenet.evaluate import point_surface_distance
-    from curvenet.hybrid import stroke_wires
+    from curvenet.evaluate.metrics import point_surface_distance
+    from curvenet.route.hybrid import stroke_wires
     box = _box_mesh()
     # along the top edge of the cube, then a zigzag away from it
     leaving = np.array([[-0.5, -0.5, 0.5], [0.5, -0.5, 0.5], [0.8, -0.5, 0.7],
@@ -189,7 +189,7 @@ def test_an_overdrawn_stroke_the_surface_misses_is_kept_as_a_wire(tmp_path):
 def test_a_round_plate_of_strokes_is_surface_like():
     """An oval rim with strokes across it: most of its hull lies near a stroke, though the
     corners of its bounding rectangle (which an oval never reaches) do not."""
-    from curvenet.hybrid import FILL_SHARE, REGION_GAP
+    from curvenet.route.hybrid import FILL_SHARE, REGION_GAP
     u = np.linspace(0, 2 * np.pi, 200)
     rim = np.c_[np.cos(u), 0.8 * np.sin(u), 0 * u]
     chords = [np.c_[np.linspace(-1, 1, 30) * np.sqrt(1 - (y / 0.8) ** 2), 0 * T[:30] + y,
@@ -230,7 +230,7 @@ _TOP_EDGE = np.c_[0 * T + 1.0, T, 0 * T + 1.0]
 def test_anchors_sample_the_patch_the_fill_continues():
     """The awning continues the top face: its anchors lie on the top (normals +-z) near
     the shared edge, none on the side face x = 1 it meets at a right angle."""
-    from curvenet.hybrid import patch_anchors
+    from curvenet.route.hybrid import patch_anchors
     box = _unit_box().subdivide().subdivide().subdivide()
     gap = 0.2
     pts, normals = patch_anchors(box.vertices, box.faces, [_TOP_EDGE], _AWNING, gap=gap,
@@ -247,7 +247,7 @@ def test_anchors_sample_the_patch_the_fill_continues():
 
 
 def test_trim_keeps_the_fill_beyond_the_shared_curve_and_drops_it_over_the_patch():
-    from curvenet.hybrid import trim_fill
+    from curvenet.route.hybrid import trim_fill
     box = _unit_box()
     # the fill continues the top face across its edge x = 1 and overlaps it by 0.3
     fill = _grid_sheet(0.7, 1.8, 0.1, 0.9, 1.0 + 1e-3, n=45)
@@ -264,7 +264,7 @@ def test_trim_keeps_the_fill_beyond_the_shared_curve_and_drops_it_over_the_patch
 
 
 def test_fill_seam_is_the_share_of_the_shared_curve_where_the_fill_boundary_meets_it():
-    from curvenet.hybrid import fill_seam
+    from curvenet.route.hybrid import fill_seam
     tol = 0.02
     met = _grid_sheet(1.0, 1.8, 0.0, 1.0, 1.0)
     assert fill_seam(met.vertices, met.faces, [_TOP_EDGE], gap=0.2, tol=tol) == \
@@ -294,7 +294,7 @@ _SMALL_NEURAL = dict(res=40, steps=40, init_steps=20, geometric_init_steps=50)
 def test_a_fill_beside_patches_meets_them_along_the_shared_curve():
     """A closed box with a drooping awning of loose strokes leaving its top edge x = 1: the
     fill is fitted with samples of the top face as data and meets the box along the edge."""
-    from curvenet.hybrid import fill_seam
+    from curvenet.route.hybrid import fill_seam
     awning = [np.c_[1.0 + 0.8 * T, 0 * T + y, 1.0 - 0.25 * T ** 2]
               for y in np.linspace(0.1, 0.9, 6)]
     sk = shapes.box().sketch()

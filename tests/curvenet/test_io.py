@@ -9,11 +9,11 @@ import networkx as nx
 import numpy as np
 import pytest
 
-from curvenet import shapes
-from curvenet.errors import SketchFormatError
-from curvenet.io import (WRITE_FORMATS, detect_format, read_network_obj, read_sketch,
+from curvenet.datasets import shapes
+from curvenet.core.errors import SketchFormatError
+from curvenet.io.sketch import (WRITE_FORMATS, detect_format, read_network_obj, read_sketch,
                          write_network_obj, write_sketch)
-from curvenet.sketch import Sketch
+from curvenet.model.sketch import Sketch
 
 
 def _sketch(seed=0, n=5):
@@ -147,7 +147,7 @@ def test_obj_junction_splits_chains_and_keeps_every_segment(tmp_path):
 
 def test_obj_fast_path_matches_token_parser(data_dir, tmp_path):
     """Oracle: the vectorised OBJ parser equals the token-by-token one on every data OBJ."""
-    from curvenet import _io_obj
+    from curvenet.io import obj as _io_obj
 
     files = (sorted((data_dir / "networks").glob("*/*.obj"))
              + sorted((data_dir / "sketches" / "vns").rglob("*.obj")))
@@ -220,7 +220,7 @@ _TEXTS = {  # name -> content; the clean ones take the vectorised path
 def test_text_reader_in_pieces_equals_token_by_token_reading(tmp_path, monkeypatch):
     """Oracle: the vectorised reading in small pieces gives the strokes, labels, warnings and
     the first error (message and line) of a token-by-token reading of the whole file."""
-    from curvenet import _io_text
+    from curvenet.io import text as _io_text
 
     files = []
     for name, text in _TEXTS.items():

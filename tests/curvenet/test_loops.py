@@ -1,4 +1,4 @@
-"""Tests of curvenet.loops: walking cycles, orienting patches, loop geometry.
+"""Tests of curvenet.cycles.loops: walking cycles, orienting patches, loop geometry.
 
 Oracles: the analytic shapes' true face loops and orientations.
 """
@@ -8,10 +8,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from curvenet import shapes
-from curvenet.cycles import find_patches
-from curvenet.errors import NetworkError
-from curvenet.loops import (cycle_to_loop, loop_points, newell_normal, orient_patches,
+from curvenet.datasets import shapes
+from curvenet.cycles.find import find_patches
+from curvenet.core.errors import NetworkError
+from curvenet.cycles.loops import (cycle_to_loop, loop_points, newell_normal, orient_patches,
                             signed_volume)
 
 

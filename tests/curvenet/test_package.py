@@ -9,7 +9,8 @@ import numpy as np
 import pytest
 
 import curvenet
-from curvenet import CurveNetwork, MeshResult, PatchSet, Sketch, shapes
+from curvenet import CurveNetwork, MeshResult, PatchSet, Sketch
+from curvenet.datasets import shapes
 
 
 def test_dir_lists_the_lazy_names_before_first_use():

@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 import curvenet
-from curvenet import Sketch, shapes
-from curvenet.evaluate import evaluate_mesh
+from curvenet import Sketch
+from curvenet.datasets import shapes
+from curvenet.evaluate.metrics import evaluate_mesh
 from curvenet.pipeline import AUTO_MIN_COVERAGE
 
 #: a neural budget small enough for CI; the decision, not the quality, is under test here
@@ -30,7 +31,7 @@ def test_auto_takes_classical_on_a_clean_network():
 def test_refine_keeps_the_classical_sphere():
     # classical then the draft flow fit (about 10 s): the refinement may lose a little but
     # must keep the surface (F 0.992 measured; 0.465 when the prefit collapsed g)
-    from curvenet.redraw import rough_sketch
+    from curvenet.datasets.redraw import rough_sketch
     s = shapes.SHAPES["sphere"]()
     res = curvenet.surface(rough_sketch(s.network, seed=0), refine=True)
     assert res.method == "classical+refine"
@@ -43,7 +44,7 @@ def test_rough_torus_keeps_one_control_spacing_per_strip():
     # control polygon's scale, stroke wobble gave single quad strips twice the control
     # points of their neighbours and the fit bulged between the curves (F 0.76-0.95 on
     # seeds 0-3; the clean torus with one strip doubled: 0.95)
-    from curvenet.redraw import rough_sketch
+    from curvenet.datasets.redraw import rough_sketch
     s = shapes.SHAPES["torus"]()
     for seed in (0, 1):
         res = curvenet.surface(rough_sketch(s.network, seed=seed), method="classical")

@@ -5,15 +5,15 @@ import networkx as nx
 import pytest
 
 import curvenet
-from curvenet import shapes
+from curvenet.datasets import shapes
 from curvenet.cli import main
-from curvenet.errors import SketchFormatError
-from curvenet.evaluate import evaluate_mesh
-from curvenet.io import read_sketch
-from curvenet.pointcurves import JUMP_RATIO, NotCurvesError, jump_ratio, recover_curves
-from curvenet.shapes import sample_curves
-from curvenet.sketch import Sketch
-from curvenet.snap import snap
+from curvenet.core.errors import SketchFormatError
+from curvenet.evaluate.metrics import evaluate_mesh
+from curvenet.io.sketch import read_sketch
+from curvenet.io.points import JUMP_RATIO, NotCurvesError, jump_ratio, recover_curves
+from curvenet.datasets.shapes import sample_curves
+from curvenet.model.sketch import Sketch
+from curvenet.snap.graph import snap
 
 # (spacing, rms noise, density ratio) as fractions of the diagonal
 CASES = {"uniform": (0.002, 0.0, 1.0), "uneven": (0.004, 0.0025, 3.0),
@@ -95,7 +95,7 @@ def test_noise_links_near_a_pole_are_dropped(case, seed):
 
 
 def test_short_triangle_bridge_dropped_long_one_kept():
-    from curvenet._pointjunctions import bridges
+    from curvenet.io.pointjunctions import bridges
     # junction 0 (many curves); junctions 1 and 2 of degree 3, joined by chain 2
     chains = [np.array([0, 10, 1]), np.array([0, 11, 2]), np.array([1, 12, 2]),
               np.array([1, 13, 3]), np.array([2, 14, 4]), np.array([0, 15, 5]),
@@ -163,7 +163,7 @@ def test_polylines_are_not_read_as_points(tmp_path):
 
 
 def read_sketch_roundtrip(sk, tmp_path):
-    from curvenet.io import write_sketch
+    from curvenet.io.sketch import write_sketch
     write_sketch(tmp_path / "s.txt", sk)
     back = read_sketch(tmp_path / "s.txt")
     assert "reading" not in back.metadata and len(back) == len(sk)

@@ -1,4 +1,4 @@
-"""Tests of curvenet.preview: pictures are written, show what they should, and are headless."""
+"""Tests of curvenet.view.preview: pictures are written, show what they should, and are headless."""
 
 from __future__ import annotations
 
@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 import trimesh
 
-from curvenet.errors import InvalidParameterError
-from curvenet.patchset import Patch, PatchSet
-from curvenet.preview import (HIGHLIGHT_COLOUR, MAX_PREVIEW_FACES, decimate_clustering,
+from curvenet.core.errors import InvalidParameterError
+from curvenet.model.patchset import Patch, PatchSet
+from curvenet.view.preview import (HIGHLIGHT_COLOUR, MAX_PREVIEW_FACES, decimate_clustering,
                               patch_polygons, render_preview)
-from curvenet.shapes import box, house
+from curvenet.datasets.shapes import box, house
 
 
 def read_png(path):
@@ -33,7 +33,7 @@ def count_colour(img, rgb, tol=0.03):
 
 
 def test_missing_folder_is_an_error_not_created(tmp_path):
-    from curvenet.errors import OutputError
+    from curvenet.core.errors import OutputError
     with pytest.raises(OutputError, match="does not exist"):
         render_preview(tmp_path / "sub" / "sphere.png", mesh=trimesh.creation.icosphere())
     assert not (tmp_path / "sub").exists()
@@ -87,7 +87,7 @@ def test_list_of_patches_needs_network(tmp_path):
 
 
 def test_sketch_strokes(tmp_path, data_dir):
-    from curvenet.io import read_sketch
+    from curvenet.io.sketch import read_sketch
 
     sketch = read_sketch(data_dir / "sketches" / "vns" / "car.obj")
     img = read_png(render_preview(tmp_path / "car.png", strokes=sketch, up="y",
@@ -115,7 +115,7 @@ def test_decimation_keeps_the_surface():
     1.8e-4 after normalising by the longest side 2: Hausdorff < 5e-4 and Chamfer (a mean,
     measured 2.3e-5) < 1e-4.
     """
-    from curvenet.evaluate import evaluate_mesh
+    from curvenet.evaluate.metrics import evaluate_mesh
 
     m = trimesh.creation.icosphere(subdivisions=6)
     m.vertices *= [1.0, 0.8, 0.6]
@@ -141,7 +141,7 @@ def test_patch_polygons_walk_the_cycle():
     centred = poly - poly.mean(axis=0)
     assert np.linalg.svd(centred, compute_uv=False)[-1] < 1e-12
     # cutting the fan into rings keeps the surface: same area, same plane
-    from curvenet.preview import _fan
+    from curvenet.view.preview import _fan
 
     def area(t):
         return 0.5 * np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1)
@@ -171,14 +171,14 @@ def test_bad_arguments(tmp_path):
 
 
 def test_import_is_light():
-    code = ("import sys, curvenet, curvenet.preview, curvenet.evaluate; "
+    code = ("import sys, curvenet, curvenet.view.preview, curvenet.evaluate; "
             "bad = [m for m in ('matplotlib', 'torch') if m in sys.modules]; "
             "sys.exit(1 if bad else 0)")
     assert subprocess.run([sys.executable, "-c", code]).returncode == 0
 
 
 def test_faces_coloured_by_route_and_wires_drawn(tmp_path):
-    from curvenet.preview import ROUTE_COLOURS, WIRE_COLOUR
+    from curvenet.view.preview import ROUTE_COLOURS, WIRE_COLOUR
     a = trimesh.creation.icosphere(subdivisions=3)
     b = a.copy()
     b.vertices += [3.0, 0.0, 0.0]

@@ -1,4 +1,4 @@
-"""Tests of curvenet.redraw: the rough re-drawing generator and the network matcher."""
+"""Tests of curvenet.datasets.redraw: the rough re-drawing generator and the network matcher."""
 
 from __future__ import annotations
 
@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from scipy.spatial import cKDTree
 
-from curvenet import shapes
-from curvenet.errors import InvalidParameterError
-from curvenet.network import CurveNetwork
-from curvenet.redraw import match_networks, rough_sketch
+from curvenet.datasets import shapes
+from curvenet.core.errors import InvalidParameterError
+from curvenet.model.network import CurveNetwork
+from curvenet.datasets.redraw import match_networks, rough_sketch
 
 
 def _dense(net, n=400):

@@ -1,6 +1,6 @@
-"""Tests of curvenet.session: suggestions against the analytic shapes' true faces.
+"""Tests of curvenet.cycles.session: suggestions against the analytic shapes' true faces.
 
-Oracles: the true faces of ``curvenet.shapes``, the cycle rank E - V + C and
+Oracles: the true faces of ``curvenet.datasets.shapes``, the cycle rank E - V + C and
 galois ranks; the terminal loop is driven by piped answers (io.StringIO).
 """
 
@@ -10,12 +10,12 @@ import io
 
 import pytest
 
-from curvenet import shapes
-from curvenet._gf2 import edge_mask, gf2_rank
-from curvenet.cycles import find_patches
-from curvenet.errors import InvalidParameterError, NetworkError
-from curvenet.patchset import PatchSet, load_network_file
-from curvenet.session import PatchSession, Suggestion, run_interactive
+from curvenet.datasets import shapes
+from curvenet.cycles.gf2 import edge_mask, gf2_rank
+from curvenet.cycles.find import find_patches
+from curvenet.core.errors import InvalidParameterError, NetworkError
+from curvenet.model.patchset import PatchSet, load_network_file
+from curvenet.cycles.session import PatchSession, Suggestion, run_interactive
 
 
 def true_faces(shape):

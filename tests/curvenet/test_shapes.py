@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 import trimesh
 
-from curvenet import shapes
-from curvenet.loops import signed_volume
+from curvenet.datasets import shapes
+from curvenet.cycles.loops import signed_volume
 
 
 @pytest.mark.parametrize("name", sorted(shapes.SHAPES))

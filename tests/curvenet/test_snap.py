@@ -7,12 +7,12 @@ import warnings
 import numpy as np
 import pytest
 
-from curvenet import shapes
-from curvenet.errors import InvalidParameterError
-from curvenet.io import read_network_obj, read_sketch
-from curvenet.redraw import match_networks, rough_sketch
-from curvenet.sketch import Sketch
-from curvenet.snap import (DEFAULT_SNAP_TOL, SnapOptions, dangling_vertices, prune_dangling,
+from curvenet.datasets import shapes
+from curvenet.core.errors import InvalidParameterError
+from curvenet.io.sketch import read_network_obj, read_sketch
+from curvenet.datasets.redraw import match_networks, rough_sketch
+from curvenet.model.sketch import Sketch
+from curvenet.snap.graph import (DEFAULT_SNAP_TOL, SnapOptions, dangling_vertices, prune_dangling,
                            snap)
 
 
@@ -138,7 +138,7 @@ def test_closed_stroke_becomes_loop_edge():
 def test_overdraw_rounds_search_only_changed_strokes_with_the_same_result(name, monkeypatch):
     """Oracle: carrying the contacts of unchanged strokes from round to round gives the
     network of a full pair search in every round."""
-    from curvenet import _snap_rough
+    from curvenet.snap import rough as _snap_rough
 
     sketch = rough_sketch(getattr(shapes, name)().network, seed=1, overdraw=1.0)
     real = _snap_rough._contacts
@@ -209,7 +209,7 @@ def test_prune_dangling():
 
 
 def test_segment_closest_points_match_brute_force():
-    from curvenet._snap_rough import _seg_seg
+    from curvenet.snap.rough import _seg_seg
 
     rng = np.random.default_rng(0)
     p0, p1, q0, q1 = (rng.normal(size=(300, 3)) for _ in range(4))

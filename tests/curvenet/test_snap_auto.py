@@ -6,10 +6,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from curvenet import _snap_auto, shapes
-from curvenet.redraw import match_networks, rough_sketch
-from curvenet.sketch import Sketch
-from curvenet.snap import DEFAULT_SNAP_TOL, snap
+from curvenet.datasets import shapes
+from curvenet.snap import auto as _snap_auto
+from curvenet.datasets.redraw import match_networks, rough_sketch
+from curvenet.model.sketch import Sketch
+from curvenet.snap.graph import DEFAULT_SNAP_TOL, snap
 
 from ._redraw2 import graph_recovered, multigraph, redraw2
 from ._redraw3 import redraw3
@@ -183,8 +184,8 @@ def test_corner_near_join_only_for_a_lone_turn():
     """The joined curve's turn near a join: an L corner 1.2 tol away is found there;
     a zigzag (sharp turns every 1.2 tol, as a tight curl) or a turn at the join
     itself (the join was judged smooth) is not a corner."""
-    from curvenet._snap_joins import _corner_near_join
-    from curvenet.snap import SnapOptions
+    from curvenet.snap.joins import _corner_near_join
+    from curvenet.snap.graph import SnapOptions
     tol, opts = 0.05, SnapOptions()
     ell = _path((-1, 0, 0), (0, 0, 0), (0, 1, 0))
     at = _corner_near_join(ell, 1.0 - 1.2 * tol, tol, opts)

@@ -12,10 +12,11 @@ import pytest
 import trimesh
 
 import curvenet
-from curvenet import MeshResult, Sketch, shapes
+from curvenet import MeshResult, Sketch
+from curvenet.datasets import shapes
 from curvenet.cli import main
-from curvenet.io import write_sketch
-from curvenet.surfacers import (SurfaceInput, get_surfacer, register_surfacer, surfacer_names,
+from curvenet.io.sketch import write_sketch
+from curvenet.route.registry import (SurfaceInput, get_surfacer, register_surfacer, surfacer_names,
                                 unregister_surfacer)
 
 
@@ -58,7 +59,7 @@ def test_builtins_are_registered_without_importing_backends():
     assert surfacer_names() == ("catmull-clark", "soapfilm", "neural")
     assert surfacer_names("patches") == ("catmull-clark", "soapfilm")
     assert get_surfacer("catmull-clark").label == "classical"
-    code = ("import sys, curvenet.surfacers, curvenet.cli; curvenet.cli.build_parser(); "
+    code = ("import sys, curvenet.route.registry, curvenet.cli; curvenet.cli.build_parser(); "
             "bad = [m for m in ('torch', 'curvenet.surfacing', 'curvenet.neural') "
             "if m in sys.modules]; sys.exit(str(bad) if bad else 0)")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
@@ -170,7 +171,7 @@ def test_an_internal_value_error_stays_internal(monkeypatch, box_obj, capsys):
 
 
 def test_route_decision_is_data():
-    from curvenet.route import auto_route
+    from curvenet.route.decision import auto_route
     res = curvenet.surface(shapes.box().sketch())
     d = res.decision
     assert (d.method, d.surfacer, d.reason, d.patches) == ("classical", "catmull-clark",

@@ -253,8 +253,8 @@ def test_bad_input(kw, match):
 
 
 def _rough_shape_sketch(name, seed=0):
-    shapes = pytest.importorskip("curvenet.shapes")
-    redraw = pytest.importorskip("curvenet.redraw")
+    shapes = pytest.importorskip("curvenet.datasets.shapes")
+    redraw = pytest.importorskip("curvenet.datasets.redraw")
     shape = shapes.SHAPES[name]()
     sk = redraw.rough_sketch(shape.network, seed=seed)
     return shape, sk

@@ -1,11 +1,11 @@
-"""End-to-end oracles of the classical surfacer on the analytic networks of curvenet.shapes."""
+"""End-to-end oracles of the classical surfacer on the analytic networks of curvenet.datasets.shapes."""
 
 import numpy as np
 import pytest
 import trimesh
 
 from curvenet import surfacing
-from curvenet import shapes
+from curvenet.datasets import shapes
 
 from ._metrics import compare
 

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from curvenet import shapes
+from curvenet.datasets import shapes
 from curvenet.surfacing.catmull_clark import edge_topology, euler_characteristic
 from curvenet.surfacing.controlmesh import build_control_mesh, orient_loops
 

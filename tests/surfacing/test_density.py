@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from curvenet.errors import InvalidParameterError
+from curvenet.core.errors import InvalidParameterError
 from curvenet.surfacing.api import DEFAULT_MAX_FACES, density_subdiv, surface_loops
 
 

@@ -1,7 +1,7 @@
 import numpy as np
 import pytest
 
-from curvenet import shapes
+from curvenet.datasets import shapes
 from curvenet.surfacing.catmull_clark import edge_topology
 from curvenet.surfacing.controlmesh import build_control_mesh
 from curvenet.surfacing.creases import sharp_structure

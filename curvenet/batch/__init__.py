@@ -1,0 +1,7 @@
+"""Many sketches in one call: a process pool or a Dask cluster, a manifest to resume from, a report."""
+
+from .run import (BatchOptions, BatchResult, LocalExecutor, DaskExecutor, run_batch, surface_task, plan_outputs,
+    MANIFEST_NAME, STATUSES)
+
+__all__ = ['BatchOptions', 'BatchResult', 'LocalExecutor', 'DaskExecutor', 'run_batch', 'surface_task',
+    'plan_outputs', 'MANIFEST_NAME', 'STATUSES']

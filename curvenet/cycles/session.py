@@ -1,0 +1,385 @@
+"""Interactive patch editing: delete, replacement and closing suggestions, accept / reject.
+
+The topology-aware interface of Abbasinejad, Joshi, Amenta 2011, Sec. 5, as a
+Python API (:class:`PatchSession`) and a terminal loop (:func:`run_interactive`)
+that reads one-key answers from any text stream, so it works on a terminal and
+with answers piped on stdin.
+
+* Deleting a patch that was part of the basis drops the rank: the session
+  suggests replacements that restore it, next-best first by the automatic
+  phase's weight (Sec. 4.2: ``k``, then the tie-break volume).
+* Closing patches add a solid: they are ranked by ``Ws = 10 (a + b) + k``
+  (Sec. 5); each suggestion names the patches that close the solid with it.
+
+The GF(2) algebra (which candidates are independent of the current patches,
+which patches sum to a candidate) is done with ``galois`` by default
+(``backend="bitset"`` gives the same answers with Python-int elimination).
+
+References
+----------
+Abbasinejad, Joshi, Amenta 2011, Sec. 5 (replacement and closing suggestions).
+"""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass, field
+
+from .gf2 import bitset_solve, edge_mask, gf2_rank, gf2_solve
+from .candidates import DEFAULT_MAX_WORK, TIE_BREAKS, CandidatePool
+from .closing import closing_suggestions
+from ..core.errors import InvalidParameterError, NetworkError, OutputError
+from .loops import cycle_to_loop
+from ..model.patchset import Patch, PatchSet, save_patchset
+
+__all__ = ["Suggestion", "PatchSession", "run_interactive"]
+
+#: Candidate cycles are enumerated up to the longest patch plus this many edges.
+EXTRA_LENGTH = 2
+#: Suggestions returned per request by default.
+DEFAULT_TOP = 10
+_BACKENDS = ("galois", "bitset")
+
+
+@dataclass(frozen=True)
+class Suggestion:
+    """A patch the session proposes.
+
+    Attributes
+    ----------
+    edges : tuple of int
+        Sorted edge ids of the cycle.
+    kind : {"replacement", "closing"}
+    score : float
+        ``k`` (Sec. 4.2, smaller is better) for replacements, ``Ws`` (Sec. 5,
+        larger is better) for closing patches.
+    size : int
+        Number of edges.
+    details : dict
+        Replacements: ``k``, ``volume``. Closing: ``a``, ``b``, ``solid``
+        (indices of current patches that close the solid with this one).
+    """
+
+    edges: tuple
+    kind: str
+    score: float
+    size: int
+    details: dict = field(default_factory=dict, compare=False, hash=False)
+
+    def describe(self) -> str:
+        """One line: kind, size, score, edges (and the solid for closing patches)."""
+        head = (f"{self.kind} patch: {self.size} edges, "
+                + (f"k = {self.score:g}" if self.kind == "replacement"
+                   else f"Ws = {self.score:.1f} (a = {self.details['a']:.2f}, "
+                        f"b = {self.details['b']})"))
+        tail = f"; edges {list(self.edges)}"
+        if self.kind == "closing":
+            tail += f"; closes a solid with patches {list(self.details['solid'])}"
+        return head + tail
+
+
+class PatchSession:
+    """Editable patch set with ranked suggestions, accept / reject and undo.
+
+    Parameters
+    ----------
+    patchset : PatchSet
+        Starting patches (e.g. from :func:`curvenet.cycles.find_patches`);
+        not modified.
+    tie_break : {"pca", "aabb"}, optional
+        Default: the one recorded in ``patchset.report``, else ``"pca"``.
+    backend : {"galois", "bitset"}
+        GF(2) solver for the suggestions.
+    max_work : int
+        Enumeration budget for candidate cycles (see :class:`~curvenet.cycles.candidates.CandidatePool`).
+
+    Notes
+    -----
+    Candidates are all cycles up to the longest current patch (or the length
+    the automatic phase reached) plus :data:`EXTRA_LENGTH` edges, within the
+    work budget. Rejected suggestions are not proposed again (until undone).
+    Every action (delete, accept, reject) can be undone, last first.
+
+    Examples
+    --------
+    >>> from curvenet.datasets.shapes import box
+    >>> from curvenet.cycles import find_patches
+    >>> s = PatchSession(find_patches(box().network))
+    >>> face = s.patches[0].edges
+    >>> s.delete(0)[0].edges == face
+    True
+    """
+
+    def __init__(self, patchset: PatchSet, *, tie_break=None, backend: str = "galois",
+                 max_work: int = DEFAULT_MAX_WORK):
+        if not isinstance(patchset, PatchSet):
+            raise InvalidParameterError(f"patchset: expected a PatchSet, got {type(patchset)!r}")
+        tie_break = tie_break or patchset.report.get("tie_break", "pca")
+        if tie_break not in TIE_BREAKS:
+            raise InvalidParameterError(f"tie_break: expected one of {TIE_BREAKS}, "
+                                        f"got {tie_break!r}")
+        if backend not in _BACKENDS:
+            raise InvalidParameterError(f"backend: expected one of {_BACKENDS}, got {backend!r}")
+        self.network = patchset.network
+        self.report = dict(patchset.report)
+        self.backend = backend
+        self._patches = [Patch(p.edges, p.source) for p in patchset.patches]
+        self._rejected: set = set()
+        self._history: list = []
+        self.pool = CandidatePool(self.network, tie_break=tie_break, max_work=max_work)
+        longest = max([len(p.edges) for p in self._patches]
+                      + [int(self.report.get("max_length", 0)), 1])
+        cands = []
+        for L in range(1, longest + EXTRA_LENGTH + 1):
+            found = self.pool.cycles_of_length(L)
+            if found is None:
+                break
+            cands.extend(found)
+        self._by_edges = {c.edges: c for c in cands}
+
+    # --- state ----------------------------------------------------------------
+    @property
+    def patches(self) -> list:
+        """Current patches (copies)."""
+        return [Patch(p.edges, p.source) for p in self._patches]
+
+    @property
+    def patchset(self) -> PatchSet:
+        """The current patch set (network shared, report copied with a ``session`` entry)."""
+        rep = dict(self.report)
+        rep["session"] = {"rejected": [list(e) for e in sorted(self._rejected)]}
+        return PatchSet(self.network, self.patches, rep)
+
+    @property
+    def full_rank(self) -> int:
+        """Rank of the cycle space, ``E - V + C``."""
+        return self.pool.cycle_rank
+
+    def rank(self) -> int:
+        """GF(2) rank of the current patches (galois)."""
+        return gf2_rank([edge_mask(p.edges) for p in self._patches], self.network.number_of_edges)
+
+    def _solve(self, targets):
+        pm = [edge_mask(p.edges) for p in self._patches]
+        tm = [c.mask for c in targets]
+        if self.backend == "galois":
+            return gf2_solve(pm, tm, self.network.number_of_edges)
+        return bitset_solve(pm, tm)
+
+    def _index(self, patch) -> int:
+        if isinstance(patch, (int,)) and not isinstance(patch, bool):
+            if not 0 <= patch < len(self._patches):
+                raise InvalidParameterError(f"patch: index {patch} out of range "
+                                            f"0..{len(self._patches) - 1}")
+            return patch
+        edges = tuple(sorted(patch.edges if isinstance(patch, Patch) else map(int, patch)))
+        for i, p in enumerate(self._patches):
+            if p.edges == edges:
+                return i
+        raise InvalidParameterError(f"patch: {list(edges)} is not a current patch")
+
+    def _push(self):
+        self._history.append(([Patch(p.edges, p.source) for p in self._patches],
+                              set(self._rejected)))
+
+    # --- suggestions ----------------------------------------------------------------
+    def replacement_suggestions(self, *, top: int = DEFAULT_TOP, exclude=()) -> list:
+        """Cycles independent of the current patches, best first by Sec. 4.2 weight.
+
+        Each one raises the rank by one (towards :attr:`full_rank`); empty when the
+        patches already have full rank.
+        """
+        current = {p.edges for p in self._patches}
+        skip = current | self._rejected | {tuple(sorted(e)) for e in exclude}
+        cands = [c for c in self.pool.all_candidates if c.edges not in skip]
+        if not cands:
+            return []
+        sols, _ = self._solve(cands)
+        free = [c for c, x in zip(cands, sols) if x is None]
+        self.pool.classify(free)
+        free.sort(key=lambda c: c.key)
+        return [Suggestion(c.edges, "replacement", float(c.k), c.length,
+                           {"k": float(c.k), "volume": c.volume, "separating": c.separating})
+                for c in free[:top]]
+
+    def closing_suggestions(self, *, top: int = DEFAULT_TOP) -> list:
+        """Closing patches (Sec. 5) ranked by ``Ws = 10 (a + b) + k``, best first."""
+        out = closing_suggestions(self.pool, [p.edges for p in self._patches],
+                                  exclude=self._rejected, backend=self.backend)
+        return [Suggestion(s["edges"], "closing", s["score"], s["size"],
+                           {"a": s["a"], "b": s["b"], "solid": s["solid"]})
+                for s in out[:top]]
+
+    # --- actions ------------------------------------------------------------------
+    def delete(self, patch, *, top: int = DEFAULT_TOP) -> list:
+        """Remove a patch; returns ranked suggestions to put in its place.
+
+        Parameters
+        ----------
+        patch : int, Patch or sequence of int
+            Index into :attr:`patches`, or the patch / its edge ids.
+
+        Returns
+        -------
+        list of Suggestion
+            If the deletion lowered the rank (a basis patch), the replacements
+            restoring it, the deleted cycle excluded (Sec. 5: "the next-best
+            patch"). If the rank is unchanged (the patch closed a solid), the
+            closing suggestions, where the deleted cycle competes like any other.
+        """
+        i = self._index(patch)
+        self._push()
+        gone = self._patches.pop(i)
+        masks = [edge_mask(p.edges) for p in self._patches]
+        sols, _ = bitset_solve(masks, [edge_mask(gone.edges)])
+        if sols[0] is None:
+            return self.replacement_suggestions(top=top, exclude=[gone.edges])
+        return self.closing_suggestions(top=top)
+
+    def accept(self, suggestion) -> Patch:
+        """Add a suggested (or any) cycle as a patch (``source`` "closing" or "user")."""
+        edges = tuple(sorted(suggestion.edges if isinstance(suggestion, Suggestion)
+                             else map(int, suggestion)))
+        if edges in {p.edges for p in self._patches}:
+            raise InvalidParameterError(f"suggestion: {list(edges)} is already a patch")
+        cycle_to_loop(self.network, edges)  # raises NetworkError if not a simple loop
+        kind = suggestion.kind if isinstance(suggestion, Suggestion) else "user"
+        self._push()
+        patch = Patch(edges, "closing" if kind == "closing" else "user")
+        self._patches.append(patch)
+        self._rejected.discard(edges)
+        return patch
+
+    def reject(self, suggestion) -> None:
+        """Never suggest this cycle again (until undone)."""
+        edges = tuple(sorted(suggestion.edges if isinstance(suggestion, Suggestion)
+                             else map(int, suggestion)))
+        self._push()
+        self._rejected.add(edges)
+
+    def undo(self) -> bool:
+        """Revert the last delete / accept / reject; False when there is nothing to undo."""
+        if not self._history:
+            return False
+        self._patches, self._rejected = self._history.pop()
+        return True
+
+    def save(self, path) -> None:
+        """Write the current patch set as ``PATCHES.json`` (atomically)."""
+        save_patchset(path, self.patchset)
+
+
+# --------------------------------------------------------------------------- terminal
+_HELP = ("commands: [l]ist patches, [d]elete a patch, [c]losing suggestions, "
+         "[r]eplacement suggestions, [u]ndo, [s]ave, [q]uit, [h]elp")
+
+
+def _ask(prompt, input, output) -> str | None:
+    output.write(prompt)
+    output.flush()
+    line = input.readline()
+    if not line:
+        return None
+    return line.strip()
+
+
+def _review(session, suggestions, input, output, preview) -> bool:
+    """Offer each suggestion: [a]ccept, [r]eject, [n]ext, [q]uit. False on end of input."""
+    if not suggestions:
+        output.write("no suggestions\n")
+        return True
+    for j, s in enumerate(suggestions):
+        output.write(f"  #{j + 1} {s.describe()}\n")
+        if preview:
+            from ..view.preview import render_preview
+            render_preview(preview, network=session.network, patches=session.patches,
+                           highlight=[list(s.edges)], title=f"{s.kind} #{j + 1}")
+            output.write(f"  preview: {preview}\n")
+        ans = _ask("  [a]ccept [r]eject [n]ext [q]uit > ", input, output)
+        if ans is None:
+            return False
+        key = ans[:1].lower()
+        if key == "a":
+            session.accept(s)
+            output.write(f"  accepted (patch {len(session.patches) - 1})\n")
+            return True
+        if key == "r":
+            session.reject(s)
+            output.write("  rejected\n")
+        elif key == "q":
+            return True
+    return True
+
+
+def run_interactive(patchset: PatchSet, *, input=sys.stdin, output=sys.stdout, preview=None,
+                    backend: str = "galois") -> PatchSet:
+    """Edit a patch set from the terminal; returns the final patch set.
+
+    Parameters
+    ----------
+    patchset : PatchSet
+    input, output : text streams
+        Answers are read one line at a time and only the first character of
+        an answer counts, so piped answers work (``printf 'c\\na\\nq\\n' | ...``).
+    preview : str or os.PathLike, optional
+        PNG written (overwritten) for every suggestion shown, the suggestion
+        highlighted (:func:`curvenet.view.preview.render_preview`).
+    backend : {"galois", "bitset"}
+
+    Returns
+    -------
+    PatchSet
+        The patches when the user quits (``q`` or end of input).
+
+    Notes
+    -----
+    Main prompt keys: ``l`` list, ``d`` delete (then the patch number), ``c``
+    closing suggestions, ``r`` replacement suggestions, ``u`` undo, ``s`` save
+    (then a path), ``q`` quit, ``h`` help. Each suggestion is answered with
+    ``a`` accept, ``r`` reject, ``n`` next, ``q`` back to the main prompt.
+    """
+    session = PatchSession(patchset, backend=backend)
+    output.write(f"{len(session.patches)} patches, rank {session.rank()} of "
+                 f"{session.full_rank}\n{_HELP}\n")
+    while True:
+        ans = _ask("patches> ", input, output)
+        if ans is None:
+            break
+        key = ans[:1].lower()
+        if key == "q":
+            break
+        if key == "l":
+            for i, p in enumerate(session.patches):
+                output.write(f"  {i}: {len(p.edges)} edges {list(p.edges)} ({p.source})\n")
+        elif key == "d":
+            arg = ans[1:].strip() or _ask("  patch number > ", input, output)
+            if arg is None:
+                break
+            try:
+                sugg = session.delete(int(arg))
+            except (ValueError, InvalidParameterError) as err:
+                output.write(f"  cannot delete {arg!r}: {err}\n")
+                continue
+            output.write(f"  deleted; rank {session.rank()} of {session.full_rank}\n")
+            if not _review(session, sugg, input, output, preview):
+                break
+        elif key == "c":
+            if not _review(session, session.closing_suggestions(), input, output, preview):
+                break
+        elif key == "r":
+            if not _review(session, session.replacement_suggestions(), input, output, preview):
+                break
+        elif key == "u":
+            output.write("  undone\n" if session.undo() else "  nothing to undo\n")
+        elif key == "s":
+            path = ans[1:].strip() or _ask("  save to > ", input, output)
+            if path is None:
+                break
+            try:
+                session.save(path)
+                output.write(f"  saved {path}\n")
+            except (OSError, NetworkError, OutputError) as err:
+                output.write(f"  cannot save {path!r}: {err}\n")
+        else:
+            output.write(_HELP + "\n")
+    return session.patchset

@@ -1,0 +1,87 @@
+"""Junction merging of :func:`curvenet.snap.snap` (step 4): connected components of
+candidate links, and which junctions near each other along a stroke merge.
+
+Private module, split from :mod:`curvenet.snap.rough` by topic; all lengths are
+absolute (``tol = snap_tol * diagonal``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
+
+__all__ = ["components", "first_items", "join_near"]
+
+
+def join_near(near, cid, gap, ends, held, L, tol):
+    """Candidate pairs ``(p, 2) int64`` that join the junctions of near pairs, closest first.
+
+    ``near``: per pair of junctions ``j1, j2`` within ``1.5 tol`` along stroke ``k``, arrays
+    ``(ds, k, j1, j2)``. ``cid (m,)``: junction of each candidate; ``gap (m,) bool``: the
+    candidate is two stroke ends; ``ends``: per (junction, stroke) pair with members, in
+    order, arrays ``(junction, stroke, only gap members, stroke end there: 0 start, 1 end,
+    2 neither or both)``. A split stroke (two stroke ends meeting in a gap, nothing else)
+    does not pull in a junction one piece passes through once the gap has joined a
+    junction some stroke passes through: a gap between two nearby crossings would chain
+    them into one. ``held`` (first candidate of a junction -> such pieces) carries over
+    rounds and is updated in place. Nor do two junctions that strokes pass through merge
+    along a short stroke that runs from one to the other (its start at one, its end at
+    the other): a piece between two gaps, each next to a crossing, would chain the two.
+    """
+    (ds, kk, j1, j2), (ej, ek, only, end) = near, ends
+    key = ej * len(L) + ek
+    split = (np.bincount(ej, minlength=cid.max() + 1) == 2) & (
+        np.bincount(ej, weights=~only, minlength=cid.max() + 1) == 0)
+    through = np.bincount(cid, weights=~gap) > 0  # some stroke passes through
+    fi = first_items(cid)
+    parent, out = {}, []
+
+    def find(j):
+        while parent.get(j, j) != j:
+            j = parent[j]
+        return j
+
+    def gap_only(j, k):
+        return only[np.searchsorted(key, j * len(L) + k)]
+
+    def spans(k, a, b):  # stroke k starts at one junction and ends at the other
+        return {int(end[np.searchsorted(key, j * len(L) + k)]) for j in (a, b)} == {0, 1}
+
+    for x in np.lexsort((j2, j1, kk, ds)).tolist():
+        k, a, b = int(kk[x]), int(j1[x]), int(j2[x])
+        ra, rb = find(a), find(b)
+        ha, hb = held.get(fi[ra], set()), held.get(fi[rb], set())
+        if ra == rb or (k in ha and not gap_only(b, k)) or (k in hb and not gap_only(a, k)):
+            continue
+        if through[ra] and through[rb] and spans(k, a, b):
+            continue
+        new = ha | hb
+        for jx, ry in ((a, rb), (b, ra)):  # a split joins a junction some stroke passes through
+            if split[jx] and through[ry]:  # (a stroke under 2 tol is all ends)
+                lo = np.searchsorted(ej, jx)
+                new |= {int(y) for y in ek[lo:lo + 2] if y != k and L[y] > 2.0 * tol}
+        root = min(ra, rb)
+        parent[max(ra, rb)] = root
+        through[root] = through[ra] or through[rb]
+        held[fi[root]] = new
+        out.append((fi[a], fi[b]))
+    return np.array(out, dtype=np.int64).reshape(-1, 2)
+
+
+def first_items(comp):
+    """Smallest item ``(c,) int64`` of each of the components ``comp (m,)`` numbers."""
+    first = np.full(comp.max() + 1, len(comp), dtype=np.int64)
+    np.minimum.at(first, comp, np.arange(len(comp)))
+    return first
+
+
+def components(m, links):
+    """Connected components of ``m`` items joined by the pairs ``links (p, 2)``, numbered
+    in the order of their smallest item (as union-find with the smaller root winning)."""
+    graph = coo_matrix((np.ones(len(links)), (links[:, 0], links[:, 1])), shape=(m, m))
+    _, comp = connected_components(graph, directed=False)
+    _, first = np.unique(comp, return_index=True)
+    rank = np.empty(len(first), dtype=np.int64)
+    rank[np.argsort(first)] = np.arange(len(first))
+    return rank[comp]

@@ -1,0 +1,181 @@
+"""Overdraw consolidation of the tolerance-based snapping (steps 3 and 7 of :mod:`curvenet.snap`).
+
+Private module, split from :mod:`curvenet.snap.rough` by topic: a stroke drawn
+over (part of) another one is cut out of the guest and averaged into the host;
+parallel edges left between the same two vertices (slivers) are averaged.
+All lengths are absolute (``tol = snap_tol * diagonal``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from .rough import _clean, _smoothstep, _Strokes
+from ..core.geometry import cumulative_length, interpolate_polyline, resample_polyline
+from ..core.tolerances import DIVISION_GUARD
+
+__all__ = ["consolidate", "merge_slivers"]
+
+
+def consolidate(st, samples, con, tol, h, opts, report):
+    """Average each overdrawn stretch into its host and cut it out of the guest."""
+    Q, _, ss, _, start, _ = samples
+    idx = np.flatnonzero(con["overlap"])
+    span = np.minimum(con["a1"] - con["a0"], con["b1"] - con["b0"])[idx]
+    idx = idx[np.argsort(-span, kind="stable")]
+    busy = set()
+    removed = set()
+    new = []
+    for c in idx:
+        a, b = int(con["a"][c]), int(con["b"][c])
+        if a in busy or b in busy:
+            continue
+        busy.update((a, b))
+        cov_a = (con["a1"][c] - con["a0"][c]) / max(st.length(a), DIVISION_GUARD)
+        cov_b = (con["b1"][c] - con["b0"][c]) / max(st.length(b), DIVISION_GUARD)
+        if cov_a > cov_b or (cov_a == cov_b and a > b):
+            guest, host = a, b
+            g0, g1, h0, h1 = con["a0"][c], con["a1"][c], con["b0"][c], con["b1"][c]
+        else:
+            guest, host = b, a
+            g0, g1, h0, h1 = con["b0"][c], con["b1"][c], con["a0"][c], con["a1"][c]
+        # the guest is covered only where its closest host sample is not a host end:
+        # a guest running on past the host's end is a continuation, not overdraw
+        hm = slice(start[host], start[host + 1])
+        hs = ss[hm]
+        lo_g = start[guest] + np.searchsorted(ss[start[guest]:start[guest + 1]], g0 - tol)
+        hi_g = start[guest] + np.searchsorted(ss[start[guest]:start[guest + 1]], g1 + tol,
+                                              side="right")
+        gm = slice(lo_g, hi_g)
+        dist, nn = cKDTree(Q[hm]).query(Q[gm])
+        cov = (dist <= tol) & (hs[nn] > 0.5 * h) & (hs[nn] < st.length(host) - 0.5 * h)
+        if not cov.any():
+            continue
+        g0, g1 = ss[gm][cov].min(), ss[gm][cov].max()
+        gp, gc = st.polys[guest], st.cums[guest]
+        gq, gsv = Q[gm], ss[gm]
+        gtree = cKDTree(gq)
+        hp, hc = st.polys[host].copy(), st.cums[host]
+        Lh = hc[-1]
+        st.srcs[host] = tuple(sorted(set(st.srcs[host]) | set(st.srcs[guest])))
+        if st.labels[guest] == "crease":
+            st.labels[host] = "crease"
+        # guest pieces outside [g0, g1]: one that continues the host past a host end
+        # lying inside the overlap is joined to the host, however short; other pieces
+        # stay as strokes if at least `trim * tol` long.
+        head_in, tail_in = h0 <= h, h1 >= Lh - h
+        join = {}
+        for lo, hi, side in ((0.0, g0, "left"), (g1, gc[-1], "right")):
+            if hi - lo <= 0.5 * h:
+                continue
+            pa = interpolate_polyline(gp, np.array([g0 if side == "left" else g1]), cum=gc)[0]
+            if tail_in and "tail" not in join and np.linalg.norm(hp[-1] - pa) <= 2.0 * tol:
+                join["tail"] = side
+            elif head_in and "head" not in join and np.linalg.norm(hp[0] - pa) <= 2.0 * tol:
+                join["head"] = side
+            elif hi - lo >= opts.trim * tol:
+                new.append((_cut(gp, gc, lo, hi), st.srcs[guest], st.labels[guest]))
+        # host over the overlap: moved halfway onto the guest (the average), tapered to 0
+        # over `ramp` at a free end, and cross-faded to 1 (onto the guest) at a joined end
+        a0 = 0.0 if "head" in join else h0
+        a1 = Lh if "tail" in join else h1
+        inside = (hc >= a0) & (hc <= a1)
+        if inside.any():
+            x = hc[inside]
+            ramp = max(min(2.0 * tol, 0.5 * (h1 - h0)), DIVISION_GUARD)  # guard: empty overlap
+            lo_f = (1.0 + _smoothstep((h0 + ramp - x) / ramp) if "head" in join
+                    else _smoothstep((x - h0) / ramp))
+            hi_f = (1.0 + _smoothstep((x - h1 + ramp) / ramp) if "tail" in join
+                    else _smoothstep((h1 - x) / ramp))
+            beta = np.minimum(0.5 * lo_f * hi_f, 1.0)
+            _, nn = gtree.query(hp[inside])
+            hp[inside] += beta[:, None] * (gq[nn] - hp[inside])
+        before, after = [], []
+        if "tail" in join:
+            gt = gsv[gtree.query(hp[-1])[1]]
+            if join["tail"] == "right" and gt < gc[-1]:
+                after = [_cut(gp, gc, gt, gc[-1])[1:]]
+            elif join["tail"] == "left" and gt > 0:
+                after = [_cut(gp, gc, 0.0, gt)[::-1][1:]]
+        if "head" in join:
+            gh = gsv[gtree.query(hp[0])[1]]
+            if join["head"] == "right" and gh < gc[-1]:
+                before = [_cut(gp, gc, gh, gc[-1])[::-1][:-1]]
+            elif join["head"] == "left" and gh > 0:
+                before = [_cut(gp, gc, 0.0, gh)[:-1]]
+        poly = _clean(np.vstack(before + [hp] + after), 0.05 * tol)
+        if before or after:  # a guest piece continues the host: maybe past its own start
+            loop = _close_loop(poly, cumulative_length(poly), tol)
+            poly = poly if loop is None else loop
+        st.set(host, poly)
+        removed.add(guest)
+        report["overdraw_consolidations"] += 1
+    if not busy:
+        return st
+    out = _Strokes()
+    for k in range(len(st)):
+        if k not in removed:
+            out.add(st.polys[k], st.srcs[k], st.labels[k], st.cums[k])
+    for p, s, lab in new:
+        out.add(p, s, lab)
+    return out
+
+
+def _close_loop(poly, cum, tol):
+    """Cut back an end that runs on past the stroke's own start; None if not a loop.
+
+    A polyline longer than ``4 tol`` is a loop when some point of its last ``3 tol``
+    comes within ``tol`` of its start, heading the way the start does (within 60
+    degrees; a stroke doubling back over its start is no loop). It is cut at the
+    closest such point, so a loop that runs past its start (a host extended by a
+    guest piece) leaves at most a gap, as a closed stroke does.
+    """
+    if cum[-1] <= 4.0 * tol:
+        return None
+    tail = np.flatnonzero(cum >= cum[-1] - 3.0 * tol)
+    d = np.linalg.norm(poly[tail] - poly[0], axis=1)
+    q = int(tail[np.argmin(d)])
+    if d.min() > tol:
+        return None
+    head = poly[np.searchsorted(cum, tol)] - poly[0]
+    back = poly[q] - poly[np.searchsorted(cum, cum[q] - tol)]
+    if head @ back <= 0.5 * np.linalg.norm(head) * np.linalg.norm(back):
+        return None
+    return poly[:q + 1]
+
+
+def _cut(poly, cum, a, b):
+    """Sub-polyline ``(m, 3)`` between arc parameters ``a < b``, exact end points."""
+    inner = (cum > a) & (cum < b)
+    ends = interpolate_polyline(poly, np.array([a, b]), cum=cum)
+    return np.vstack([ends[:1], poly[inner], ends[1:]])
+
+
+def merge_slivers(edges, tol):
+    """Average parallel edges (same end vertices) whose curves stay within ``2 tol``."""
+    count = 0
+    groups = {}
+    for e_id, e in enumerate(edges):
+        if e[0] != e[1]:
+            groups.setdefault((min(e[0], e[1]), max(e[0], e[1])), []).append(e_id)
+    dead = set()
+    for (u, _v), ids in sorted(groups.items()):
+        for x in range(len(ids)):
+            for y in range(x + 1, len(ids)):
+                ex, ey = ids[x], ids[y]
+                if ex in dead or ey in dead:
+                    continue
+                cx, cy = (resample_polyline(edges[k][2] if edges[k][0] == u else edges[k][2][::-1],
+                                            63) for k in (ex, ey))
+                if np.linalg.norm(cx - cy, axis=1).max() <= 2.0 * tol:
+                    avg = 0.5 * (cx + cy)
+                    e = edges[ex]
+                    label = "crease" if "crease" in (e[4], edges[ey][4]) else "boundary"
+                    if e[0] != u:
+                        avg = avg[::-1]
+                    edges[ex] = (e[0], e[1], avg, tuple(sorted(set(e[3]) | set(edges[ey][3]))),
+                                 label)
+                    dead.add(ey)
+                    count += 1
+    return [e for i, e in enumerate(edges) if i not in dead], count

@@ -1,0 +1,638 @@
+"""The tolerance-based snapping of :func:`curvenet.snap.snap` (``mode="rough"``).
+
+Private module; the steps and constants are documented in :mod:`curvenet.snap`.
+All lengths below are absolute (``tol = snap_tol * diagonal``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.ndimage import maximum_filter1d
+from scipy.spatial import cKDTree
+
+from .auto import check_density
+from .joins import chord_turn, dissolve
+from .merge import components, join_near
+from ..core.geometry import arc_length, cumulative_length, interpolate_polyline
+from ..core.tolerances import DIVISION_GUARD
+from ..model.network import CurveNetwork
+
+__all__ = ["dedup", "snap_rough"]
+
+#: Bound on the stroke samples of one snap: the sample spacing grows past tol / 4 to keep
+#: the total length / spacing under it.
+_MAX_SAMPLES = 2_000_000
+#: Samples of changed strokes whose neighbours are sought at once (bounds the pairs held).
+_PAIR_BLOCK = 100_000
+
+
+# --------------------------------------------------------------------------- small tools
+def dedup(poly, eps):
+    """Drop points within ``eps`` of their predecessor (the last point is kept)."""
+    poly = np.asarray(poly, dtype=np.float64)
+    if len(poly) < 2:
+        return poly
+    d = np.linalg.norm(np.diff(poly, axis=0), axis=1)
+    keep = np.concatenate([[True], d > eps])
+    out = poly[keep]
+    if not keep[-1] and len(out) > 1:
+        out[-1] = poly[-1]
+    return out
+
+
+def _clean(poly, eps):
+    """Drop interior points closer than ``eps`` to their predecessor; ends stay exact.
+
+    Removes the needle segments that joins and cuts can leave (their direction is
+    noise and shows as a kink). A run of such points is dropped whole, which only
+    lengthens one segment.
+    """
+    if len(poly) <= 2:
+        return poly
+    keep = np.ones(len(poly), dtype=bool)
+    keep[1:-1] = np.linalg.norm(np.diff(poly[:-1], axis=0), axis=1) >= eps
+    idx = np.flatnonzero(keep)
+    if len(idx) > 2 and np.linalg.norm(poly[-1] - poly[idx[-2]]) < eps:
+        keep[idx[-2]] = False
+    return poly[keep]
+
+
+def _bump(x):
+    """C1 bump ``(1 - x^2)^2`` for ``|x| < 1``, else 0: value 1 and slope 0 at 0."""
+    x = np.minimum(np.abs(x), 1.0)
+    return (1.0 - x * x) ** 2
+
+
+def _smoothstep(x):
+    x = np.clip(x, 0.0, 1.0)
+    return x * x * (3.0 - 2.0 * x)
+
+
+# --------------------------------------------------------------------------- state
+class _Strokes:
+    """Working strokes: polylines, arc lengths, source ids and labels."""
+
+    def __init__(self):
+        self.polys, self.cums, self.srcs, self.labels = [], [], [], []
+
+    def add(self, poly, srcs, label, cum=None):
+        self.polys.append(poly)
+        self.cums.append(cumulative_length(poly) if cum is None else cum)
+        self.srcs.append(tuple(sorted(set(srcs))))
+        self.labels.append(label)
+
+    def set(self, k, poly):
+        self.polys[k] = poly
+        self.cums[k] = cumulative_length(poly)
+
+    def __len__(self):
+        return len(self.polys)
+
+    def length(self, k):
+        return self.cums[k][-1]
+
+
+class _Flat:
+    """All strokes concatenated, for vectorised arc-length lookups.
+
+    Stroke ``k``'s points are ``P[first[k]:first[k] + count[k]]``; its arc
+    parameter ``s`` maps to the global parameter ``s + off[k]`` on the
+    concatenated polyline, where consecutive strokes are separated by a gap of
+    ``sep`` (so a lookup never lands on the joining segment's interior).
+    """
+
+    def __init__(self, st):
+        self.count = np.array([len(p) for p in st.polys])
+        self.first = np.concatenate([[0], np.cumsum(self.count)[:-1]])
+        self.P = np.concatenate(st.polys)
+        self.L = np.array([c[-1] for c in st.cums])
+        sep = float(self.L.sum()) + 1.0
+        self.off = np.concatenate([[0.0], np.cumsum(self.L + sep)[:-1]])
+        self.G = np.concatenate([c + o for c, o in zip(st.cums, self.off)])
+
+    def interp(self, k, s):
+        """Points ``(m, 3)`` at arc parameters ``s (m,)`` of strokes ``k (m,)`` (clamped)."""
+        k = np.asarray(k, dtype=np.int64)
+        g = np.clip(np.asarray(s, dtype=np.float64), 0.0, self.L[k]) + self.off[k]
+        j = np.clip(np.searchsorted(self.G, g, side="right") - 1, 0, len(self.G) - 2)
+        seg = self.G[j + 1] - self.G[j]
+        t = np.clip((g - self.G[j]) / np.maximum(seg, DIVISION_GUARD), 0.0, 1.0)  # guard 0-length
+        return self.P[j] + t[:, None] * (self.P[j + 1] - self.P[j])
+
+
+def _sample(st, h):
+    """Uniform samples of every stroke at spacing <= h.
+
+    Returns
+    -------
+    (Q, sid, ss, tan, start, flat) : points (M, 3), stroke id (M,), arc parameter (M,),
+        unit tangent (M, 3), ``start (S + 1,)`` with stroke k's samples at
+        ``start[k]:start[k + 1]``, and the :class:`_Flat` arc-length table of the strokes.
+    """
+    flat = _Flat(st)
+    n = np.maximum(2, np.ceil(flat.L / h).astype(np.int64) + 1)
+    start = np.concatenate([[0], np.cumsum(n)])
+    sid = np.repeat(np.arange(len(n)), n)
+    local = np.arange(start[-1]) - start[sid]
+    ss = local * (flat.L / (n - 1))[sid]
+    ss[start[1:] - 1] = flat.L  # exact ends
+    Q = flat.interp(sid, ss)
+    nxt = np.minimum(np.arange(len(Q)) + 1, start[sid + 1] - 1)
+    prv = np.maximum(np.arange(len(Q)) - 1, start[sid])
+    tan = Q[nxt] - Q[prv]
+    tan /= np.maximum(np.linalg.norm(tan, axis=1, keepdims=True), DIVISION_GUARD)  # guard 0-length
+    return Q, sid, ss, tan, start, flat
+
+
+def _contacts(samples, tol, h, st, opts, since=None):
+    """Group close sample pairs of different strokes into contacts.
+
+    Parameters
+    ----------
+    since : (contacts, start, old) or None
+        The previous round's contacts and sample starts, and per stroke its index in
+        that round when it is unchanged since (its samples are then the same), else -1.
+        Only the sample pairs of changed strokes are searched (all pairs when they hold
+        most samples); the contacts between unchanged strokes are carried over, renumbered.
+
+    Returns
+    -------
+    dict of arrays, one entry per contact, ordered by strokes ``a < b`` and the start
+    on ``a``: extents on each stroke (``a0, a1, b0, b1``), closest pair ``(i, j)``
+    (sample indices) and its distance ``dist``, ``overlap`` flag.
+    """
+    Q, sid, _, _, start = samples[:5]
+    fresh = None if since is None else since[2] < 0
+    if fresh is None or 2 * np.count_nonzero(fresh[sid]) > len(Q):  # most strokes changed
+        return _group_pairs(cKDTree(Q).query_pairs(tol, output_type="ndarray"), samples, tol,
+                            h, st, opts)
+    con0, start0, old = since
+    qc = np.flatnonzero(fresh[sid])  # samples of the changed strokes
+    tree, parts = cKDTree(Q), []
+    for lo in range(0, len(qc), _PAIR_BLOCK):  # in blocks: most pairs found are discarded
+        qb = qc[lo:lo + _PAIR_BLOCK]
+        near = cKDTree(Q[qb]).sparse_distance_matrix(tree, tol, output_type="ndarray")
+        i, j = qb[near["i"]], near["j"].astype(np.int64)
+        keep = (sid[i] != sid[j]) & (~fresh[sid[j]] | (i < j))  # each pair once
+        parts.append(np.stack([i[keep], j[keep]], axis=1))
+    pairs = np.concatenate(parts) if parts else np.zeros((0, 2), dtype=np.int64)
+    con = _group_pairs(pairs, samples, tol, h, st, opts)
+    now = np.full(len(start0) - 1, -1)
+    now[old[~fresh]] = np.flatnonzero(~fresh)
+    a, b = now[con0["a"]], now[con0["b"]]
+    kept = np.flatnonzero((a >= 0) & (b >= 0))
+    carried = {k: v[kept] for k, v in con0.items()}
+    carried.update(a=a[kept], b=b[kept],
+                   i=con0["i"][kept] - start0[con0["a"][kept]] + start[a[kept]],
+                   j=con0["j"][kept] - start0[con0["b"][kept]] + start[b[kept]])
+    both = {k: np.concatenate([carried[k], con[k]]) for k in con}
+    order = np.lexsort((both["a0"], both["b"], both["a"]))
+    return {k: v[order] for k, v in both.items()}
+
+
+def _group_pairs(pairs, samples, tol, h, st, opts):
+    """Contacts (see :func:`_contacts`) from the close sample pairs ``(p, 2)``."""
+    Q, sid, ss, tan = samples[:4]
+    empty = {k: np.zeros(0, dtype=np.int64) for k in ("a", "b", "i", "j")}
+    if len(pairs) == 0:
+        return dict(empty, overlap=np.zeros(0, bool), a0=np.zeros(0), a1=np.zeros(0),
+                    b0=np.zeros(0), b1=np.zeros(0), dist=np.zeros(0))
+    pairs = pairs[sid[pairs[:, 0]] != sid[pairs[:, 1]]]
+    swap = sid[pairs[:, 0]] > sid[pairs[:, 1]]
+    pairs[swap] = pairs[swap][:, ::-1]
+    i, j = pairs[:, 0], pairs[:, 1]
+    a, b = sid[i], sid[j]
+    key = a * len(st) + b
+    order = np.lexsort((ss[j], ss[i], key))
+    i, j, a, b, key = i[order], j[order], a[order], b[order], key[order]
+    if len(i) == 0:
+        return dict(empty, overlap=np.zeros(0, bool), a0=np.zeros(0), a1=np.zeros(0),
+                    b0=np.zeros(0), b1=np.zeros(0), dist=np.zeros(0))
+    brk = np.concatenate([[True], (key[1:] != key[:-1]) | (np.diff(ss[i]) > 2.5 * h)])
+    # a parallel run that touches both ends of `b`, over far more of `b` than of `a`
+    # (a short stroke drawn over the opening of a nearly closed one), is split along `b`
+    lengths = np.array([st.length(k) for k in range(len(st))])
+    cos_od = np.cos(np.radians(opts.overdraw_angle))
+    run = np.cumsum(brk) - 1
+    rs = np.flatnonzero(brk)
+    lo_b, hi_b = np.minimum.reduceat(ss[j], rs), np.maximum.reduceat(ss[j], rs)
+    cosang = np.abs(np.einsum("ij,ij->i", tan[i], tan[j]))
+    par = np.add.reduceat(cosang, rs) / np.diff(np.append(rs, len(i))) >= cos_od
+    both = par & (lo_b <= h) & (hi_b >= lengths[b[rs]] - h) & (
+        hi_b - lo_b > np.maximum.reduceat(ss[i], rs) - np.minimum.reduceat(ss[i], rs) + 4 * tol)
+    if both.any():
+        order = np.lexsort((ss[i], ss[j], run))
+        i, j, a, b, run, cosang = (x[order] for x in (i, j, a, b, run, cosang))
+        brk = np.concatenate([[True], (run[1:] != run[:-1])
+                              | ((np.diff(ss[j]) > 2.5 * h) & both[run[1:]])])
+    start = np.flatnonzero(brk)
+    comp = np.cumsum(brk) - 1
+    a0 = np.minimum.reduceat(ss[i], start)
+    a1 = np.maximum.reduceat(ss[i], start)
+    b0 = np.minimum.reduceat(ss[j], start)
+    b1 = np.maximum.reduceat(ss[j], start)
+    mean_cos = np.add.reduceat(cosang, start) / np.diff(np.append(start, len(i)))
+    dist = np.linalg.norm(Q[i] - Q[j], axis=1)
+    best = np.lexsort((dist, comp))
+    first = np.concatenate([[True], comp[best][1:] != comp[best][:-1]])
+    bi = best[first]
+    lo = opts.overdraw_length * tol
+    sa, sb = a[start], b[start]
+    end_a = (a0 <= h) | (a1 >= lengths[sa] - h)
+    end_b = (b0 <= h) | (b1 >= lengths[sb] - h)
+    long_run = ((a1 - a0) >= lo) & ((b1 - b0) >= lo)
+    # two strokes that continue each other with a short overlap (end inside end)
+    end_to_end = end_a & end_b & ((a1 - a0) >= tol) & ((b1 - b0) >= tol)
+    # a short stroke drawn (mostly) over a part of another one
+    covered = (((a1 - a0) >= 0.8 * lengths[sa]) | ((b1 - b0) >= 0.8 * lengths[sb])) & (
+        (a1 - a0) >= 2.0 * tol) & ((b1 - b0) >= 2.0 * tol)
+    overlap = (long_run | end_to_end | covered) & (mean_cos >= cos_od)
+    return {"a": sa, "b": sb, "i": i[bi], "j": j[bi], "a0": a0, "a1": a1,
+            "b0": b0, "b1": b1, "overlap": overlap, "dist": dist[bi]}
+
+
+def _overdraw_rounds(st, tol, h, opts, report):
+    """Consolidate overdraw (up to 12 rounds) before junctions are sought.
+
+    Returns the strokes, their samples and their contacts (none an overlap).
+    """
+    from .overdraw import consolidate  # it imports this module's helpers
+    since = None
+    for _round in range(12):
+        samples = _sample(st, h)
+        if _round == 0:
+            check_density(samples, tol, opts.snap_tol)
+        con = _contacts(samples, tol, h, st, opts, since)
+        if not con["overlap"].any():
+            return st, samples, con
+        polys = list(st.polys)  # consolidate edits st: keep the polylines before it
+        st = consolidate(st, samples, con, tol, h, opts, report)
+        since = (con, samples[4], _unchanged(polys, st.polys))
+    samples = _sample(st, h)
+    con = _contacts(samples, tol, h, st, opts, since)
+    if con["overlap"].any():
+        report["warnings"].append("overdraw left after 12 rounds; treated as crossings")
+        con["overlap"][:] = False
+    return st, samples, con
+
+
+def _unchanged(before, after):
+    """Per polyline of ``after``, its index in ``before`` if it is the same object, else -1.
+
+    Both lists must be alive (an object's id is unique only among live objects).
+    """
+    index = {id(p): k for k, p in enumerate(before)}
+    return np.array([index.get(id(p), -1) for p in after], dtype=np.int64)
+
+
+# --------------------------------------------------------------------------- junctions
+def _seg_seg(p0, p1, q0, q1):
+    """Closest points of segment pairs, batched (Ericson, Real-Time Collision Detection 5.1.9).
+
+    Parameters
+    ----------
+    p0, p1, q0, q1 : (n, 3) float64
+        Segments ``p0 -> p1`` and ``q0 -> q1``.
+
+    Returns
+    -------
+    s, t : (n,) float64 in [0, 1]
+        The closest points are ``p0 + s (p1 - p0)`` and ``q0 + t (q1 - q0)``.
+    """
+    d1, d2, r = p1 - p0, q1 - q0, p0 - q0
+    a = np.maximum(np.einsum("ij,ij->i", d1, d1), DIVISION_GUARD)  # guard: degenerate segments
+    e = np.maximum(np.einsum("ij,ij->i", d2, d2), DIVISION_GUARD)
+    b = np.einsum("ij,ij->i", d1, d2)
+    c = np.einsum("ij,ij->i", d1, r)
+    f = np.einsum("ij,ij->i", d2, r)
+    denom = a * e - b * b
+    par = denom <= 1e-12 * a * e  # parallel (sin^2 of the angle < 1e-12; local): take the start
+    s = np.where(par, 0.0, np.clip((b * f - c * e) / np.where(par, 1.0, denom), 0.0, 1.0))
+    t = (b * s + f) / e
+    s = np.where(t < 0, np.clip(-c / a, 0, 1), np.where(t > 1, np.clip((b - c) / a, 0, 1), s))
+    return s, np.clip(t, 0.0, 1.0)
+
+
+def _candidates(st, samples, con, tol, h):
+    """Junction candidates: positions ``(m, 3)``, the two member strokes ``(m, 2) int64``
+    and arc parameters on them ``(m, 2) float64`` of each, and the number of closed strokes.
+
+    Each point contact's closest sample pair is refined to the closest points of
+    the sample segments around it (four segment pairs, batched). The candidate
+    sits at their midpoint, or on the other stroke when only one side is an end
+    (a T-junction lands on the through stroke).
+    """
+    Q, sid, ss, _, start, flat = samples
+    keep = np.flatnonzero(~con["overlap"])
+    i, j = con["i"][keep], con["j"][keep]
+    a, b = sid[i], sid[j]
+    best_d = np.full(len(keep), np.inf)
+    pa, pb = Q[i].copy(), Q[j].copy()
+    sa, sb = ss[i].copy(), ss[j].copy()
+    for di in (-1, 0):
+        for dj in (-1, 0):
+            ia = np.clip(i + di, start[a], start[a + 1] - 2)
+            jb = np.clip(j + dj, start[b], start[b + 1] - 2)
+            u, v = _seg_seg(Q[ia], Q[ia + 1], Q[jb], Q[jb + 1])
+            xa = Q[ia] + u[:, None] * (Q[ia + 1] - Q[ia])
+            xb = Q[jb] + v[:, None] * (Q[jb + 1] - Q[jb])
+            d = np.linalg.norm(xa - xb, axis=1)
+            better = d < best_d
+            best_d[better] = d[better]
+            pa[better], pb[better] = xa[better], xb[better]
+            sa[better] = (ss[ia] + u * (ss[ia + 1] - ss[ia]))[better]
+            sb[better] = (ss[jb] + v * (ss[jb + 1] - ss[jb]))[better]
+    end_a = (sa <= 0.5 * h) | (sa >= flat.L[a] - 0.5 * h)
+    end_b = (sb <= 0.5 * h) | (sb >= flat.L[b] - 0.5 * h)
+    pos = np.where((end_a & ~end_b)[:, None], pb,
+                   np.where((end_b & ~end_a)[:, None], pa, 0.5 * (pa + pb)))
+    closed = [k for k in range(len(st))  # closed strokes: the two ends meet
+              if st.length(k) > 4.0 * tol and np.linalg.norm(st.polys[k][0] - st.polys[k][-1])
+              <= tol]
+    ends = np.array([[st.polys[k][0], st.polys[k][-1]] for k in closed]).reshape(-1, 2, 3)
+    pos = np.vstack([pos, 0.5 * (ends[:, 0] + ends[:, 1])])
+    mk = np.concatenate([np.stack([a, b], axis=1), np.repeat(closed, 2).reshape(-1, 2)])
+    ms = np.concatenate([np.stack([sa, sb], axis=1),
+                         np.array([[0.0, st.length(k)] for k in closed]).reshape(-1, 2)])
+    return pos, mk.astype(np.int64), ms.astype(np.float64), len(closed)
+
+
+def _closest_params(samples, k, lo, hi, target, h):
+    """Arc parameters in ``[lo, hi]`` of strokes ``k`` closest to ``target``, batched.
+
+    Parameters
+    ----------
+    k : (m,) int64; lo, hi : (m,) float64; target : (m, 3) float64
+
+    Returns
+    -------
+    (m,) float64
+        The nearest sample in the window, refined on a grid of ``h / 4`` around it.
+    """
+    Q, sid, ss, _, start, flat = samples
+    k = np.asarray(k, dtype=np.int64)
+    lo = np.maximum(0.0, lo)
+    hi = np.minimum(flat.L[k], hi)
+    gs = ss + flat.off[sid]  # global sample parameter, increasing
+    i0 = np.searchsorted(gs, lo + flat.off[k])
+    i1 = np.searchsorted(gs, hi + flat.off[k], side="right")
+    i0 = np.clip(i0, start[k], start[k + 1] - 1)
+    i1 = np.clip(np.maximum(i1, i0 + 1), start[k] + 1, start[k + 1])
+    lens = i1 - i0
+    q = np.repeat(np.arange(len(k)), lens)
+    idx = np.repeat(i0, lens) + (np.arange(lens.sum()) - np.repeat(np.cumsum(lens) - lens, lens))
+    d = np.linalg.norm(Q[idx] - target[q], axis=1)
+    order = np.lexsort((d, q))
+    first = np.concatenate([[0], np.cumsum(lens)[:-1]])
+    best = idx[order[first]]
+    grid = np.linspace(-h, h, 9)
+    fine = np.clip(ss[best][:, None] + grid[None, :], lo[:, None], hi[:, None])  # (m, 9)
+    p = flat.interp(np.repeat(k, 9), fine.ravel()).reshape(-1, 9, 3)
+    pick = np.argmin(np.linalg.norm(p - target[:, None, :], axis=2), axis=1)
+    return fine[np.arange(len(k)), pick]
+
+
+def _cluster(samples, pos, mk, ms, tol, h):
+    """Merge candidates into junctions; returns (positions, per-stroke member lists).
+
+    ``mk``, ``ms`` (m, 2): the strokes each candidate lies on and its arc parameters
+    there. Per-stroke member list: sorted list of (s, junction id). Candidates within
+    ``tol`` merge; so do junctions that land within ``1.5 tol`` of each other along
+    one stroke (a corner whose pairwise contacts scattered), closest first, for up to
+    four rounds (see :func:`curvenet.snap.merge.join_near` for the pairs that do not
+    merge). Junctions are numbered by their first candidate.
+    """
+    m = len(pos)
+    if m == 0:
+        return np.zeros((0, 3)), {}
+    links = (cKDTree(pos).query_pairs(tol, output_type="ndarray") if m > 1
+             else np.zeros((0, 2), dtype=np.int64))  # candidates joined
+    mc = np.repeat(np.arange(m), 2)  # the candidate of each member
+    L = samples[5].L
+    gap = ((ms <= 0.5 * h) | (ms >= L[mk] - 0.5 * h)).all(axis=1)  # two stroke ends only
+    mk, ms = mk.ravel(), ms.ravel()
+    held = {}  # first candidate of a junction -> strokes that end there only by a split
+    for _ in range(4):
+        cid = components(m, links)
+        J = np.zeros((cid.max() + 1, 3))
+        np.add.at(J, cid, pos)
+        J /= np.bincount(cid, minlength=len(J))[:, None]
+        # each stroke's members of one junction, in runs no more than 2 tol apart: the
+        # point of the run's window on the stroke closest to the junction
+        jm = cid[mc]
+        order = np.lexsort((ms, mk, jm))
+        k_o, s_o, j_o = mk[order], ms[order], jm[order]
+        pair = np.concatenate([[True], (k_o[1:] != k_o[:-1]) | (j_o[1:] != j_o[:-1])])
+        new = pair | np.concatenate([[False], np.diff(s_o) > 2.0 * tol])
+        first = np.flatnonzero(new)
+        last = np.append(first[1:], len(order)) - 1
+        qk, qj = k_o[first], j_o[first]
+        qs = (_closest_params(samples, qk, s_o[first] - tol, s_o[last] + tol, J[qj], h)
+              if len(qk) else np.zeros(0))
+        # per stroke by (s, junction): neighbours of different junctions closer than 1.5 tol
+        by = np.lexsort((qj, qs, qk))
+        qk, qs, qj = qk[by], qs[by], qj[by]
+        near = (qk[1:] == qk[:-1]) & (qj[1:] != qj[:-1]) & (np.diff(qs) < 1.5 * tol)
+        if not near.any():
+            break
+        g = np.flatnonzero(pair)  # (junction, stroke) pairs, in order: all gaps there? the
+        side = np.where(s_o <= 0.5 * h, 0, np.where(s_o >= L[k_o] - 0.5 * h, 1, 2))
+        lo_s, hi_s = np.minimum.reduceat(side, g), np.maximum.reduceat(side, g)
+        ends = (j_o[g], k_o[g], np.logical_and.reduceat(gap[mc[order]], g),
+                np.where(lo_s == hi_s, lo_s, 2))  # stroke end there: 0 start, 1 end, 2 other
+        joined = join_near((np.diff(qs)[near], qk[1:][near], qj[:-1][near], qj[1:][near]),
+                            cid, gap, ends, held, L, tol)
+        if len(joined) == 0:
+            break
+        links = np.concatenate([links, joined])
+    # one stroke, one junction, two equal parameters: keep one
+    per_stroke = {}
+    for k, s, jn in zip(qk.tolist(), qs.tolist(), qj.tolist()):
+        out = per_stroke.setdefault(k, [])
+        if out and out[-1][1] == jn and abs(out[-1][0] - s) < 0.5 * h:
+            continue
+        out.append((s, jn))
+    return J, per_stroke
+
+
+def _corners(samples, tol, h, opts):
+    """Sharp turns: ``{stroke: [s, ...]}``, local maxima of the turn above the threshold.
+
+    The turn at ``s`` is the angle between the chords ``p(s - w) -> p(s)`` and
+    ``p(s) -> p(s + w)``, ``w = corner_window * tol``, evaluated every ``h / 2``
+    on all strokes at once.
+    """
+    flat = samples[5]
+    w = opts.corner_window * tol
+    ok = np.flatnonzero(flat.L > 2 * w)
+    if opts.corner_angle >= 180 or ok.size == 0:
+        return {}
+    n = np.maximum(3, np.ceil((flat.L[ok] - 2 * w) / (0.5 * h)).astype(np.int64) + 1)
+    pad = int(np.ceil(w / (0.5 * h))) + 1  # -1 entries between strokes stop the filter
+    start = np.concatenate([[0], np.cumsum(n + pad)])
+    kk = np.repeat(ok, n)
+    rel = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)
+    s = w + rel * np.repeat((flat.L[ok] - 2 * w) / (n - 1), n)
+    pos = rel + np.repeat(start[:-1], n)
+    p0, p1, p2 = flat.interp(kk, s - w), flat.interp(kk, s), flat.interp(kk, s + w)
+    ang = np.full(start[-1], -1.0)
+    ang[pos] = chord_turn(p0, p1, p2)
+    peak = (ang >= maximum_filter1d(ang, 2 * pad - 1, mode="nearest")) & (ang > opts.corner_angle)
+    out = {}
+    inv = -np.ones(start[-1], dtype=np.int64)
+    inv[pos] = np.arange(len(pos))
+    for q in inv[np.flatnonzero(peak)]:
+        lst = out.setdefault(int(kk[q]), [])
+        if not lst or s[q] - lst[-1] > w:
+            lst.append(float(s[q]))
+    return out
+
+
+# --------------------------------------------------------------------------- assembly
+def _displace_and_split(poly, cum, cuts, disp, tol, opts):
+    """Move a stroke onto its junctions with C1 bumps and cut it there.
+
+    Parameters
+    ----------
+    cuts : (k,) float64, increasing arc parameters
+    disp : (k, 3) float64, displacement at each cut
+
+    Returns the list of k + 1 pieces (first and last may be ``None`` when a cut
+    sits at the stroke's end).
+    """
+    k = len(cuts)
+    gaps = np.diff(np.concatenate([[-np.inf], cuts, [np.inf]]))
+    R = np.minimum(opts.blend * tol, 0.45 * np.minimum(gaps[:-1], gaps[1:]))
+    R = np.maximum(R, DIVISION_GUARD)  # guard: coincident cuts are removed before this point
+    s_all = np.concatenate([cum, cuts])
+    p_all = np.vstack([poly, interpolate_polyline(poly, cuts, cum=cum)])
+    is_cut = np.concatenate([np.zeros(len(cum), bool), np.ones(k, bool)])
+    # drop polyline vertices closer than tol / 10 to a cut: no needle segments there
+    near = np.zeros(len(cum), bool)
+    if k:
+        near = np.min(np.abs(cum[:, None] - cuts[None, :]), axis=1) < 0.1 * tol
+    keep = np.concatenate([~near, np.ones(k, bool)])
+    s_all, p_all, is_cut = s_all[keep], p_all[keep], is_cut[keep]
+    order = np.argsort(s_all, kind="stable")
+    s_all, p_all, is_cut = s_all[order], p_all[order], is_cut[order]
+    if k:
+        wts = _bump((s_all[:, None] - cuts[None, :]) / R[None, :])  # (n, k)
+        p_all = p_all + wts @ disp
+    cut_pos = np.flatnonzero(is_cut)
+    pieces = []
+    bounds = [0, *cut_pos.tolist(), len(s_all) - 1]
+    for q in range(k + 1):
+        lo, hi = bounds[q], bounds[q + 1]
+        pieces.append(p_all[lo:hi + 1] if hi > lo else None)
+    return pieces
+
+
+def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
+    """Tolerance-based snapping; see :mod:`curvenet.snap` for the steps."""
+    from .overdraw import merge_slivers  # it imports this module's helpers
+    tol = opts.snap_tol * diag
+    report = {"mode": "rough", "crossings": 0, "t_junctions": 0, "gap_merges": 0,
+              "closed_strokes": 0, "trimmed_overshoots": 0, "overdraw_consolidations": 0,
+              "corners": 0, "dissolved_joins": 0, "slivers_merged": 0,
+              "strokes_dropped_short": 0, "warnings": []}
+    st = _Strokes()
+    for p, s, lab in zip(strokes, src, labels):
+        if arc_length(p) < opts.min_length * tol:
+            report["strokes_dropped_short"] += 1
+            continue
+        st.add(p, (s,), lab)
+    if not len(st):
+        report["warnings"].append("every stroke is shorter than min_length * tol")
+        net = CurveNetwork(np.zeros((0, 3)))
+        net.report = report
+        return net
+    total = sum(st.length(k) for k in range(len(st)))
+    h = max(0.25 * tol, total / _MAX_SAMPLES)
+    st, samples, con = _overdraw_rounds(st, tol, h, opts, report)
+    pos, mk, ms, report["closed_strokes"] = _candidates(st, samples, con, tol, h)
+    J, per_stroke = _cluster(samples, pos, mk, ms, tol, h)
+    nj = len(J)
+    verts = [p for p in J]
+    corner_ids = set()
+    for k, found in sorted(_corners(samples, tol, h, opts).items()):  # degree-2 vertices
+        taken = [s for s, _ in per_stroke.get(k, [])]
+        for s in found:
+            if all(abs(s - t) > 2.0 * tol for t in taken):
+                vid = len(verts)
+                verts.append(interpolate_polyline(st.polys[k], np.array([s]), cum=st.cums[k])[0])
+                corner_ids.add(vid)
+                per_stroke.setdefault(k, []).append((s, vid))
+                report["corners"] += 1
+    # classify junctions by how strokes meet there
+    ends_at = np.zeros(len(verts), np.int64)
+    through = np.zeros(len(verts), np.int64)
+    edges = []
+    verts_arr = np.array(verts).reshape(-1, 3)
+    flat = samples[5]
+    for k in range(len(st)):
+        poly, cum = st.polys[k], st.cums[k]
+        L = cum[-1]
+        lst = sorted(per_stroke.get(k, []))
+        cuts = np.array([s for s, _ in lst])
+        ids = [j for _, j in lst]
+        for s, j in lst:
+            if j in corner_ids:
+                continue
+            if s <= 0.5 * h or s >= L - 0.5 * h:
+                ends_at[j] += 1
+            else:
+                through[j] += 1
+        disp = verts_arr[ids] - flat.interp(np.full(len(cuts), k), cuts) if ids else \
+            np.zeros((0, 3))
+        pieces = _displace_and_split(poly, cum, cuts, disp, tol, opts)
+        lab = st.labels[k]
+        for q, piece in enumerate(pieces):
+            if piece is None or len(piece) < 2:
+                continue
+            plen = arc_length(piece)
+            free_head = q == 0
+            free_tail = q == len(pieces) - 1
+            if (free_head or free_tail) and ids:
+                if plen < opts.trim * tol:
+                    report["trimmed_overshoots"] += 1
+                    continue
+            if plen <= 0:
+                continue
+            if free_head and free_tail:  # no junction on this stroke
+                u = len(verts)
+                verts.append(piece[0])
+                v = len(verts)
+                verts.append(piece[-1])
+            elif free_head:
+                u = len(verts)
+                verts.append(piece[0])
+                v = ids[0]
+            elif free_tail:
+                u = ids[-1]
+                v = len(verts)
+                verts.append(piece[-1])
+            else:
+                u, v = ids[q - 1], ids[q]
+                if u == v and plen < opts.trim * tol:  # a tiny loop at one junction
+                    report["trimmed_overshoots"] += 1
+                    continue
+            edges.append((u, v, piece, st.srcs[k], lab))
+    for j in range(nj):
+        if through[j] >= 2:
+            report["crossings"] += 1
+        elif through[j] == 1 and ends_at[j] >= 1:
+            report["t_junctions"] += 1
+        elif through[j] == 0 and ends_at[j] >= 2:
+            report["gap_merges"] += 1
+    edges = dissolve(edges, corner_ids, tol, opts, verts, report)
+    edges, report["slivers_merged"] = merge_slivers(edges, tol)
+    if report["slivers_merged"]:  # a junction of slivers may be left of degree 2
+        edges = dissolve(edges, corner_ids, tol, opts, verts, report)
+    used = sorted({e[0] for e in edges} | {e[1] for e in edges})
+    new_id = {v: i for i, v in enumerate(used)}
+    net = CurveNetwork(np.array([verts[v] for v in used]).reshape(-1, 3))
+    for u, v, curve, srcs, lab in edges:
+        net.add_edge(new_id[u], new_id[v], _clean(curve, 0.05 * tol), strokes=srcs, label=lab)
+    net.report = report
+    return net
+
