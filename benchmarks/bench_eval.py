@@ -25,7 +25,7 @@ import trimesh
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from curvenet.evaluate.metrics import evaluate_mesh  # noqa: E402
+from curvenet.evaluate import evaluate_mesh  # noqa: E402
 from curvenet.view.preview import render_preview  # noqa: E402
 from tests.curvenet.test_evaluate import independent_metrics  # noqa: E402
 

@@ -141,7 +141,7 @@ def bench_caps(args) -> None:
     import torch
     import trimesh
 
-    from curvenet.evaluate.metrics import evaluate_mesh
+    from curvenet.evaluate import evaluate_mesh
     from curvenet.datasets.shapes import capped_cylinder
 
     torch.set_num_threads(args.threads)
@@ -214,7 +214,7 @@ class _Oracle:
 def bench_splat(args) -> None:
     import torch
 
-    from curvenet.evaluate.metrics import evaluate_mesh
+    from curvenet.evaluate import evaluate_mesh
 
     torch.set_num_threads(args.threads)
     oracle = _Oracle(args.shape, args.res, args.stroke_samples)
@@ -238,7 +238,7 @@ def bench_refit(args) -> None:
     import torch
 
     from bench_sharpnet import box_dihedrals
-    from curvenet.evaluate.metrics import evaluate_mesh
+    from curvenet.evaluate import evaluate_mesh
     from curvenet.neural.creases import crease_refine
     from curvenet.neural.extract import keep_supported_components
 

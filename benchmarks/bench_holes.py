@@ -27,7 +27,7 @@ import numpy as np
 from curvenet.datasets import shapes
 from curvenet.cycles.find import find_patches
 from curvenet.core.errors import CurvenetError
-from curvenet.evaluate.metrics import evaluate_mesh, stroke_distance
+from curvenet.evaluate import evaluate_mesh, stroke_distance
 from curvenet.cycles.loops import orient_boundaries
 from curvenet.pipeline import surface
 from curvenet.surfacing.holes import surface_boundaries

@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 
 import curvenet
-from curvenet.evaluate.metrics import stroke_distance
+from curvenet.evaluate import stroke_distance
 
 DATA = Path(os.environ.get("CURVENET_DATA",
                            Path(__file__).resolve().parents[1].parent / "shared" / "data"))

@@ -25,7 +25,7 @@ vns        time and stroke fidelity per sketch (``--vns-quality``, default draft
            several vns sketches (``--vns all``: every ``*.obj`` under sketches/vns), PNG
            previews under ``--png-dir`` (default /tmp); fidelity is the share of stroke
            length within 1 % of the sketch's diagonal of the surface, as ``curvenet eval``
-           reports it (:func:`curvenet.evaluate.sketch_fidelity`)
+           reports it (:func:`curvenet.core.fidelity.sketch_fidelity`)
 
 Measured 2026-11-24 on the shared 2-core CPU (load average 3-7 from other engineers;
 alone, draft takes ~12-16 s per sketch, as phone_flowrep/trebol show):
@@ -97,7 +97,7 @@ def _worker(spec: dict) -> dict:
     if device.startswith("cuda"):
         out["gpu_peak_gb"] = torch.cuda.max_memory_allocated() / 1e9
     if spec["kind"] != "sphere" and len(r.faces):
-        from curvenet.evaluate.metrics import sketch_fidelity
+        from curvenet.core.fidelity import sketch_fidelity
         out["fidelity"] = sketch_fidelity((r.vertices, r.faces), sk)["surface"]
     if spec["kind"] != "sketch":
         from tests.neural._metrics import fscore

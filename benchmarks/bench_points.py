@@ -96,7 +96,7 @@ def rates(seeds: int, names) -> None:
 
 def fscore(names, cases) -> None:
     import curvenet
-    from curvenet.evaluate.metrics import evaluate_mesh
+    from curvenet.evaluate import evaluate_mesh
     print("| shape | case | F true curves | F recovered | difference (points) |")
     print("|---|---|---|---|---|")
     for name in names:

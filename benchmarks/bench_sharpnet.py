@@ -225,7 +225,7 @@ def _preview(meshes: dict, path: Path) -> None:
 def bench_box(args) -> None:
     import torch
 
-    from curvenet.evaluate.metrics import evaluate_mesh
+    from curvenet.evaluate import evaluate_mesh
     from curvenet.datasets.redraw import rough_sketch
     from curvenet.datasets.shapes import box
     from curvenet.neural.creases import crease_refine

@@ -32,7 +32,7 @@ import numpy as np
 
 from curvenet.datasets import shapes
 from curvenet.core.errors import CurvenetError
-from curvenet.evaluate.metrics import evaluate_mesh, stroke_distance
+from curvenet.evaluate import evaluate_mesh, stroke_distance
 from curvenet.pipeline import SurfaceResult, surface
 
 DATA = Path(os.environ.get("CURVENET_DATA", Path(__file__).resolve().parents[2] / "shared/data"))

@@ -227,7 +227,7 @@ def _cmd_patches(args) -> int:
         check_output_path(args.preview, inputs=[args.input, args.output], what="--preview")
     ps = patches(args.input, snap_tol=args.snap_tol, close=args.close, points=_points(args))
     if args.interactive:
-        from .cycles.session import run_interactive
+        from .review import run_interactive
         ps = run_interactive(ps, input=sys.stdin, output=sys.stdout, preview=args.preview)
     save_patchset(args.output, ps)
     t = ps.report.get("timings", {})
@@ -348,7 +348,7 @@ def _cmd_surface(args) -> int:
         for line in row.get("regions", []):
             print(f"  region {line}")
         if row.get("fidelity"):
-            from .evaluate.metrics import format_fidelity
+            from .core.fidelity import format_fidelity
             print(format_fidelity(row["fidelity"]))
         if row.get("cad"):
             print("\n".join(_cad_lines(row["cad"])))
@@ -475,7 +475,7 @@ def _cmd_eval(args) -> int:
         metrics = evaluate_mesh(args.mesh, args.reference, n_samples=args.samples,
                                 threshold=args.threshold, seed=args.seed)
     else:
-        from .evaluate.metrics import sketch_fidelity
+        from .core.fidelity import sketch_fidelity
         from .io.sketch import read_sketch
         from .io.meshes import read_obj_wires
         sketch = read_sketch(ref)

@@ -522,8 +522,8 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
 
 
 def _fidelity(res: SurfaceResult) -> None:
-    """``diagnostics["fidelity"]``: :func:`curvenet.evaluate.sketch_fidelity` of the result."""
-    from .evaluate.metrics import sketch_fidelity
+    """``diagnostics["fidelity"]``: :func:`curvenet.core.fidelity.sketch_fidelity` of the result."""
+    from .core.fidelity import sketch_fidelity
     t = time.perf_counter()
     ref = res.sketch if res.sketch is not None else res.network
     res.diagnostics["fidelity"] = sketch_fidelity(res.mesh, ref, wires=res.wires)

@@ -727,7 +727,7 @@ def _polished(fit: _FlowFit, f, mesh, strokes, labels, cut_boundary):
     smooth strokes; where the strokes' extra density is what holds the surface on them
     (open rims, sparse sketches) it moves the surface off them instead. So the polished
     surface is kept only when its stroke fidelity
-    (:func:`curvenet.evaluate.sketch_fidelity`) is at least that of ``mesh``.
+    (:func:`curvenet.core.fidelity.sketch_fidelity`) is at least that of ``mesh``.
 
     Returns ``(mesh, {"fidelity": [last step's, polished], "kept": bool})``.
     """
@@ -740,7 +740,7 @@ def _polished(fit: _FlowFit, f, mesh, strokes, labels, cut_boundary):
 def _fidelity(V, F, strokes) -> float:
     """Stroke fidelity of the mesh ``(V, F)`` (0 when it has no triangle of positive area)."""
     from curvenet.core.errors import InvalidParameterError
-    from curvenet.evaluate.metrics import sketch_fidelity
+    from curvenet.core.fidelity import sketch_fidelity
     try:
         return sketch_fidelity((V, F), strokes)["surface"]
     except InvalidParameterError:          # no faces, or only degenerate ones

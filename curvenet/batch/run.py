@@ -169,7 +169,7 @@ def surface_task(path: str, data: bytes | None, options: BatchOptions, *,
 
 
 def _surface_file(local: str, options: BatchOptions, tmp: str, *, preview, tile, up) -> dict:
-    from ..evaluate.metrics import stroke_fidelity
+    from ..core.fidelity import stroke_fidelity
     from ..pipeline import surface
     res = surface(local, method=options.method, snap_tol=options.snap_tol,
                   close=options.close, surfacer=options.surfacer, subdiv=options.subdiv,

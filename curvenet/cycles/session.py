@@ -1,9 +1,8 @@
 """Interactive patch editing: delete, replacement and closing suggestions, accept / reject.
 
 The topology-aware interface of Abbasinejad, Joshi, Amenta 2011, Sec. 5, as a
-Python API (:class:`PatchSession`) and a terminal loop (:func:`run_interactive`)
-that reads one-key answers from any text stream, so it works on a terminal and
-with answers piped on stdin.
+Python API (:class:`PatchSession`); :mod:`curvenet.review` puts it in front of a
+user (the terminal loop :func:`curvenet.review.run_interactive`).
 
 * Deleting a patch that was part of the basis drops the rank: the session
   suggests replacements that restore it, next-best first by the automatic
@@ -22,7 +21,6 @@ Abbasinejad, Joshi, Amenta 2011, Sec. 5 (replacement and closing suggestions).
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass, field
 
 from .gf2 import bitset_solve, edge_mask, gf2_rank, gf2_solve
@@ -32,7 +30,7 @@ from ..core.errors import InvalidParameterError, NetworkError, OutputError
 from .loops import cycle_to_loop
 from ..model.patchset import Patch, PatchSet, save_patchset
 
-__all__ = ["Suggestion", "PatchSession", "run_interactive"]
+__all__ = ["Suggestion", "PatchSession"]
 
 #: Candidate cycles are enumerated up to the longest patch plus this many edges.
 EXTRA_LENGTH = 2
@@ -267,119 +265,3 @@ class PatchSession:
     def save(self, path) -> None:
         """Write the current patch set as ``PATCHES.json`` (atomically)."""
         save_patchset(path, self.patchset)
-
-
-# --------------------------------------------------------------------------- terminal
-_HELP = ("commands: [l]ist patches, [d]elete a patch, [c]losing suggestions, "
-         "[r]eplacement suggestions, [u]ndo, [s]ave, [q]uit, [h]elp")
-
-
-def _ask(prompt, input, output) -> str | None:
-    output.write(prompt)
-    output.flush()
-    line = input.readline()
-    if not line:
-        return None
-    return line.strip()
-
-
-def _review(session, suggestions, input, output, preview) -> bool:
-    """Offer each suggestion: [a]ccept, [r]eject, [n]ext, [q]uit. False on end of input."""
-    if not suggestions:
-        output.write("no suggestions\n")
-        return True
-    for j, s in enumerate(suggestions):
-        output.write(f"  #{j + 1} {s.describe()}\n")
-        if preview:
-            from ..view.preview import render_preview
-            render_preview(preview, network=session.network, patches=session.patches,
-                           highlight=[list(s.edges)], title=f"{s.kind} #{j + 1}")
-            output.write(f"  preview: {preview}\n")
-        ans = _ask("  [a]ccept [r]eject [n]ext [q]uit > ", input, output)
-        if ans is None:
-            return False
-        key = ans[:1].lower()
-        if key == "a":
-            session.accept(s)
-            output.write(f"  accepted (patch {len(session.patches) - 1})\n")
-            return True
-        if key == "r":
-            session.reject(s)
-            output.write("  rejected\n")
-        elif key == "q":
-            return True
-    return True
-
-
-def run_interactive(patchset: PatchSet, *, input=sys.stdin, output=sys.stdout, preview=None,
-                    backend: str = "galois") -> PatchSet:
-    """Edit a patch set from the terminal; returns the final patch set.
-
-    Parameters
-    ----------
-    patchset : PatchSet
-    input, output : text streams
-        Answers are read one line at a time and only the first character of
-        an answer counts, so piped answers work (``printf 'c\\na\\nq\\n' | ...``).
-    preview : str or os.PathLike, optional
-        PNG written (overwritten) for every suggestion shown, the suggestion
-        highlighted (:func:`curvenet.view.preview.render_preview`).
-    backend : {"galois", "bitset"}
-
-    Returns
-    -------
-    PatchSet
-        The patches when the user quits (``q`` or end of input).
-
-    Notes
-    -----
-    Main prompt keys: ``l`` list, ``d`` delete (then the patch number), ``c``
-    closing suggestions, ``r`` replacement suggestions, ``u`` undo, ``s`` save
-    (then a path), ``q`` quit, ``h`` help. Each suggestion is answered with
-    ``a`` accept, ``r`` reject, ``n`` next, ``q`` back to the main prompt.
-    """
-    session = PatchSession(patchset, backend=backend)
-    output.write(f"{len(session.patches)} patches, rank {session.rank()} of "
-                 f"{session.full_rank}\n{_HELP}\n")
-    while True:
-        ans = _ask("patches> ", input, output)
-        if ans is None:
-            break
-        key = ans[:1].lower()
-        if key == "q":
-            break
-        if key == "l":
-            for i, p in enumerate(session.patches):
-                output.write(f"  {i}: {len(p.edges)} edges {list(p.edges)} ({p.source})\n")
-        elif key == "d":
-            arg = ans[1:].strip() or _ask("  patch number > ", input, output)
-            if arg is None:
-                break
-            try:
-                sugg = session.delete(int(arg))
-            except (ValueError, InvalidParameterError) as err:
-                output.write(f"  cannot delete {arg!r}: {err}\n")
-                continue
-            output.write(f"  deleted; rank {session.rank()} of {session.full_rank}\n")
-            if not _review(session, sugg, input, output, preview):
-                break
-        elif key == "c":
-            if not _review(session, session.closing_suggestions(), input, output, preview):
-                break
-        elif key == "r":
-            if not _review(session, session.replacement_suggestions(), input, output, preview):
-                break
-        elif key == "u":
-            output.write("  undone\n" if session.undo() else "  nothing to undo\n")
-        elif key == "s":
-            path = ans[1:].strip() or _ask("  save to > ", input, output)
-            if path is None:
-                break
-            try:
-                session.save(path)
-                output.write(f"  saved {path}\n")
-            except (OSError, NetworkError, OutputError) as err:
-                output.write(f"  cannot save {path!r}: {err}\n")
-        else:
-            output.write(_HELP + "\n")
-    return session.patchset

@@ -1,7 +1,11 @@
-"""Scores of a surface: against a reference mesh (Chamfer, Hausdorff, normals, F-score), against its strokes, over folders of pairs."""
+"""Scores of a surface: against a reference mesh (Chamfer, Hausdorff, normal error,
+F-score), against its strokes (distance, fidelity), over folders of pairs."""
 
-from .metrics import (evaluate_mesh, stroke_distance, stroke_fidelity, sketch_fidelity, format_report,
-    load_mesh_arrays, sample_surface, point_surface_distance, stroke_samples)
+from ..core.distance import load_mesh_arrays, point_surface_distance
+from ..core.fidelity import format_fidelity, sketch_fidelity, stroke_fidelity, stroke_samples
+from ..core.geometry import sample_surface
+from .metrics import UNIT_MISMATCH_RATIO, evaluate_mesh, format_report, stroke_distance
 
-__all__ = ['evaluate_mesh', 'stroke_distance', 'stroke_fidelity', 'sketch_fidelity', 'format_report',
-    'load_mesh_arrays', 'sample_surface', 'point_surface_distance', 'stroke_samples']
+__all__ = ["evaluate_mesh", "stroke_distance", "format_report", "UNIT_MISMATCH_RATIO",
+           "stroke_fidelity", "sketch_fidelity", "format_fidelity", "stroke_samples",
+           "load_mesh_arrays", "point_surface_distance", "sample_surface"]

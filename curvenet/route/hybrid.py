@@ -26,7 +26,8 @@ from scipy.spatial import cKDTree
 
 from ..core.geometry import (arc_length, boundary_edges, cumulative_length, densify_polyline,
                             face_normals_areas, interpolate_polyline, sample_surface)
-from ..evaluate.metrics import FIDELITY_TOL_REL, STROKE_SPACING_REL, point_surface_distance, stroke_samples
+from ..core.distance import point_surface_distance
+from ..core.fidelity import FIDELITY_TOL_REL, STROKE_SPACING_REL, stroke_samples
 
 __all__ = ["REGION_GAP", "plan_regions", "region_strokes", "patch_anchors", "trim_fill",
            "close_seam", "fill_seam", "assemble", "stroke_wires"]

@@ -35,6 +35,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..core.errors import InvalidParameterError
+from .strokes import Strokes, sample
 
 __all__ = ["AUTO_MAX", "SketchTooDense", "auto_tolerance", "check_density"]
 
@@ -73,13 +74,12 @@ def auto_tolerance(strokes, diag, default):
     (float, str)
         The tolerance as a fraction of ``diag``, and one clause saying why.
     """
-    from .rough import _sample, _Strokes
-    st = _Strokes()
+    st = Strokes()
     for k, p in enumerate(strokes):
         st.add(p, (k,), "boundary")
     total = sum(st.length(k) for k in range(len(st)))
     h = max(_STEP * diag, total / _MAX_POINTS)
-    Q, sid, _, tan, start, _ = _sample(st, h)
+    Q, sid, _, tan, start, _ = sample(st, h)
     tree = cKDTree(Q)
     reach = 0.1 * diag
     k = min(_K, len(Q))

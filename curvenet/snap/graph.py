@@ -78,7 +78,7 @@ from scipy.spatial import cKDTree
 from ..core.tolerances import COINCIDENT_REL, DUPLICATE_POINT_REL, check_snap_tol
 from ..core.errors import InvalidParameterError
 from .merge import components, first_items
-from .rough import dedup
+from .strokes import dedup
 from ..model.network import CurveNetwork, indexed_network
 from ..model.sketch import Sketch
 

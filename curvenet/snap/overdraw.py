@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .rough import _clean, _smoothstep, _Strokes
+from .strokes import Strokes, clean, smoothstep
 from ..core.geometry import cumulative_length, interpolate_polyline, resample_polyline
 from ..core.tolerances import DIVISION_GUARD
 
@@ -84,10 +84,10 @@ def consolidate(st, samples, con, tol, h, opts, report):
         if inside.any():
             x = hc[inside]
             ramp = max(min(2.0 * tol, 0.5 * (h1 - h0)), DIVISION_GUARD)  # guard: empty overlap
-            lo_f = (1.0 + _smoothstep((h0 + ramp - x) / ramp) if "head" in join
-                    else _smoothstep((x - h0) / ramp))
-            hi_f = (1.0 + _smoothstep((x - h1 + ramp) / ramp) if "tail" in join
-                    else _smoothstep((h1 - x) / ramp))
+            lo_f = (1.0 + smoothstep((h0 + ramp - x) / ramp) if "head" in join
+                    else smoothstep((x - h0) / ramp))
+            hi_f = (1.0 + smoothstep((x - h1 + ramp) / ramp) if "tail" in join
+                    else smoothstep((h1 - x) / ramp))
             beta = np.minimum(0.5 * lo_f * hi_f, 1.0)
             _, nn = gtree.query(hp[inside])
             hp[inside] += beta[:, None] * (gq[nn] - hp[inside])
@@ -104,7 +104,7 @@ def consolidate(st, samples, con, tol, h, opts, report):
                 before = [_cut(gp, gc, gh, gc[-1])[::-1][:-1]]
             elif join["head"] == "left" and gh > 0:
                 before = [_cut(gp, gc, 0.0, gh)[:-1]]
-        poly = _clean(np.vstack(before + [hp] + after), 0.05 * tol)
+        poly = clean(np.vstack(before + [hp] + after), 0.05 * tol)
         if before or after:  # a guest piece continues the host: maybe past its own start
             loop = _close_loop(poly, cumulative_length(poly), tol)
             poly = poly if loop is None else loop
@@ -113,7 +113,7 @@ def consolidate(st, samples, con, tol, h, opts, report):
         report["overdraw_consolidations"] += 1
     if not busy:
         return st
-    out = _Strokes()
+    out = Strokes()
     for k in range(len(st)):
         if k not in removed:
             out.add(st.polys[k], st.srcs[k], st.labels[k], st.cums[k])

@@ -13,135 +13,19 @@ from scipy.spatial import cKDTree
 from .auto import check_density
 from .joins import chord_turn, dissolve
 from .merge import components, join_near
-from ..core.geometry import arc_length, cumulative_length, interpolate_polyline
+from .overdraw import consolidate, merge_slivers
+from .strokes import Strokes, bump, clean, sample
+from ..core.geometry import arc_length, interpolate_polyline
 from ..core.tolerances import DIVISION_GUARD
 from ..model.network import CurveNetwork
 
-__all__ = ["dedup", "snap_rough"]
+__all__ = ["snap_rough"]
 
 #: Bound on the stroke samples of one snap: the sample spacing grows past tol / 4 to keep
 #: the total length / spacing under it.
 _MAX_SAMPLES = 2_000_000
 #: Samples of changed strokes whose neighbours are sought at once (bounds the pairs held).
 _PAIR_BLOCK = 100_000
-
-
-# --------------------------------------------------------------------------- small tools
-def dedup(poly, eps):
-    """Drop points within ``eps`` of their predecessor (the last point is kept)."""
-    poly = np.asarray(poly, dtype=np.float64)
-    if len(poly) < 2:
-        return poly
-    d = np.linalg.norm(np.diff(poly, axis=0), axis=1)
-    keep = np.concatenate([[True], d > eps])
-    out = poly[keep]
-    if not keep[-1] and len(out) > 1:
-        out[-1] = poly[-1]
-    return out
-
-
-def _clean(poly, eps):
-    """Drop interior points closer than ``eps`` to their predecessor; ends stay exact.
-
-    Removes the needle segments that joins and cuts can leave (their direction is
-    noise and shows as a kink). A run of such points is dropped whole, which only
-    lengthens one segment.
-    """
-    if len(poly) <= 2:
-        return poly
-    keep = np.ones(len(poly), dtype=bool)
-    keep[1:-1] = np.linalg.norm(np.diff(poly[:-1], axis=0), axis=1) >= eps
-    idx = np.flatnonzero(keep)
-    if len(idx) > 2 and np.linalg.norm(poly[-1] - poly[idx[-2]]) < eps:
-        keep[idx[-2]] = False
-    return poly[keep]
-
-
-def _bump(x):
-    """C1 bump ``(1 - x^2)^2`` for ``|x| < 1``, else 0: value 1 and slope 0 at 0."""
-    x = np.minimum(np.abs(x), 1.0)
-    return (1.0 - x * x) ** 2
-
-
-def _smoothstep(x):
-    x = np.clip(x, 0.0, 1.0)
-    return x * x * (3.0 - 2.0 * x)
-
-
-# --------------------------------------------------------------------------- state
-class _Strokes:
-    """Working strokes: polylines, arc lengths, source ids and labels."""
-
-    def __init__(self):
-        self.polys, self.cums, self.srcs, self.labels = [], [], [], []
-
-    def add(self, poly, srcs, label, cum=None):
-        self.polys.append(poly)
-        self.cums.append(cumulative_length(poly) if cum is None else cum)
-        self.srcs.append(tuple(sorted(set(srcs))))
-        self.labels.append(label)
-
-    def set(self, k, poly):
-        self.polys[k] = poly
-        self.cums[k] = cumulative_length(poly)
-
-    def __len__(self):
-        return len(self.polys)
-
-    def length(self, k):
-        return self.cums[k][-1]
-
-
-class _Flat:
-    """All strokes concatenated, for vectorised arc-length lookups.
-
-    Stroke ``k``'s points are ``P[first[k]:first[k] + count[k]]``; its arc
-    parameter ``s`` maps to the global parameter ``s + off[k]`` on the
-    concatenated polyline, where consecutive strokes are separated by a gap of
-    ``sep`` (so a lookup never lands on the joining segment's interior).
-    """
-
-    def __init__(self, st):
-        self.count = np.array([len(p) for p in st.polys])
-        self.first = np.concatenate([[0], np.cumsum(self.count)[:-1]])
-        self.P = np.concatenate(st.polys)
-        self.L = np.array([c[-1] for c in st.cums])
-        sep = float(self.L.sum()) + 1.0
-        self.off = np.concatenate([[0.0], np.cumsum(self.L + sep)[:-1]])
-        self.G = np.concatenate([c + o for c, o in zip(st.cums, self.off)])
-
-    def interp(self, k, s):
-        """Points ``(m, 3)`` at arc parameters ``s (m,)`` of strokes ``k (m,)`` (clamped)."""
-        k = np.asarray(k, dtype=np.int64)
-        g = np.clip(np.asarray(s, dtype=np.float64), 0.0, self.L[k]) + self.off[k]
-        j = np.clip(np.searchsorted(self.G, g, side="right") - 1, 0, len(self.G) - 2)
-        seg = self.G[j + 1] - self.G[j]
-        t = np.clip((g - self.G[j]) / np.maximum(seg, DIVISION_GUARD), 0.0, 1.0)  # guard 0-length
-        return self.P[j] + t[:, None] * (self.P[j + 1] - self.P[j])
-
-
-def _sample(st, h):
-    """Uniform samples of every stroke at spacing <= h.
-
-    Returns
-    -------
-    (Q, sid, ss, tan, start, flat) : points (M, 3), stroke id (M,), arc parameter (M,),
-        unit tangent (M, 3), ``start (S + 1,)`` with stroke k's samples at
-        ``start[k]:start[k + 1]``, and the :class:`_Flat` arc-length table of the strokes.
-    """
-    flat = _Flat(st)
-    n = np.maximum(2, np.ceil(flat.L / h).astype(np.int64) + 1)
-    start = np.concatenate([[0], np.cumsum(n)])
-    sid = np.repeat(np.arange(len(n)), n)
-    local = np.arange(start[-1]) - start[sid]
-    ss = local * (flat.L / (n - 1))[sid]
-    ss[start[1:] - 1] = flat.L  # exact ends
-    Q = flat.interp(sid, ss)
-    nxt = np.minimum(np.arange(len(Q)) + 1, start[sid + 1] - 1)
-    prv = np.maximum(np.arange(len(Q)) - 1, start[sid])
-    tan = Q[nxt] - Q[prv]
-    tan /= np.maximum(np.linalg.norm(tan, axis=1, keepdims=True), DIVISION_GUARD)  # guard 0-length
-    return Q, sid, ss, tan, start, flat
 
 
 def _contacts(samples, tol, h, st, opts, since=None):
@@ -256,10 +140,9 @@ def _overdraw_rounds(st, tol, h, opts, report):
 
     Returns the strokes, their samples and their contacts (none an overlap).
     """
-    from .overdraw import consolidate  # it imports this module's helpers
     since = None
     for _round in range(12):
-        samples = _sample(st, h)
+        samples = sample(st, h)
         if _round == 0:
             check_density(samples, tol, opts.snap_tol)
         con = _contacts(samples, tol, h, st, opts, since)
@@ -268,7 +151,7 @@ def _overdraw_rounds(st, tol, h, opts, report):
         polys = list(st.polys)  # consolidate edits st: keep the polylines before it
         st = consolidate(st, samples, con, tol, h, opts, report)
         since = (con, samples[4], _unchanged(polys, st.polys))
-    samples = _sample(st, h)
+    samples = sample(st, h)
     con = _contacts(samples, tol, h, st, opts, since)
     if con["overlap"].any():
         report["warnings"].append("overdraw left after 12 rounds; treated as crossings")
@@ -516,7 +399,7 @@ def _displace_and_split(poly, cum, cuts, disp, tol, opts):
     order = np.argsort(s_all, kind="stable")
     s_all, p_all, is_cut = s_all[order], p_all[order], is_cut[order]
     if k:
-        wts = _bump((s_all[:, None] - cuts[None, :]) / R[None, :])  # (n, k)
+        wts = bump((s_all[:, None] - cuts[None, :]) / R[None, :])  # (n, k)
         p_all = p_all + wts @ disp
     cut_pos = np.flatnonzero(is_cut)
     pieces = []
@@ -529,13 +412,12 @@ def _displace_and_split(poly, cum, cuts, disp, tol, opts):
 
 def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
     """Tolerance-based snapping; see :mod:`curvenet.snap` for the steps."""
-    from .overdraw import merge_slivers  # it imports this module's helpers
     tol = opts.snap_tol * diag
     report = {"mode": "rough", "crossings": 0, "t_junctions": 0, "gap_merges": 0,
               "closed_strokes": 0, "trimmed_overshoots": 0, "overdraw_consolidations": 0,
               "corners": 0, "dissolved_joins": 0, "slivers_merged": 0,
               "strokes_dropped_short": 0, "warnings": []}
-    st = _Strokes()
+    st = Strokes()
     for p, s, lab in zip(strokes, src, labels):
         if arc_length(p) < opts.min_length * tol:
             report["strokes_dropped_short"] += 1
@@ -632,7 +514,7 @@ def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
     new_id = {v: i for i, v in enumerate(used)}
     net = CurveNetwork(np.array([verts[v] for v in used]).reshape(-1, 3))
     for u, v, curve, srcs, lab in edges:
-        net.add_edge(new_id[u], new_id[v], _clean(curve, 0.05 * tol), strokes=srcs, label=lab)
+        net.add_edge(new_id[u], new_id[v], clean(curve, 0.05 * tol), strokes=srcs, label=lab)
     net.report = report
     return net
 

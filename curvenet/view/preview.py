@@ -439,7 +439,7 @@ def _preview_mesh(mesh, face_route, routes):
     """
     if mesh is None:
         return None, None, None
-    from ..evaluate.metrics import load_mesh_arrays
+    from ..core.distance import load_mesh_arrays
 
     mesh_v, mesh_f = load_mesh_arrays(mesh, name="mesh")
     v, f, index = decimate_clustering(mesh_v, mesh_f, MAX_PREVIEW_FACES, return_index=True)

@@ -19,7 +19,7 @@ from curvenet.datasets import shapes
 from curvenet.batch.run import MANIFEST_NAME, BatchOptions, plan_outputs, read_manifest, run_batch
 from curvenet.cli import main
 from curvenet.core.errors import InvalidParameterError
-from curvenet.evaluate.metrics import stroke_fidelity
+from curvenet.core.fidelity import stroke_fidelity
 from curvenet.io.sketch import write_sketch
 
 

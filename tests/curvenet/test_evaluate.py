@@ -10,8 +10,8 @@ import trimesh
 from scipy.spatial import cKDTree
 
 from curvenet.core.errors import InvalidParameterError, SketchFormatError
-from curvenet.evaluate.metrics import (evaluate_mesh, format_report, load_mesh_arrays,
-                               sample_surface, stroke_distance)
+from curvenet.evaluate import (evaluate_mesh, format_report, load_mesh_arrays, sample_surface,
+                               stroke_distance)
 
 
 # ---------------------------------------------------------------------------

@@ -168,7 +168,7 @@ def _classical(s):
 
 @pytest.mark.parametrize("name", CAD)
 def test_cad_classical_fscore(name):
-    from curvenet.evaluate.metrics import evaluate_mesh
+    from curvenet.evaluate import evaluate_mesh
     s = shapes.CAD_SHAPES[name]()
     res = _classical(s)
     assert evaluate_mesh(res.mesh, s.reference_mesh(4), n_samples=30_000)["fscore"] >= 0.99

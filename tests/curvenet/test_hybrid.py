@@ -6,7 +6,7 @@ import pytest
 import curvenet
 from curvenet.datasets import shapes
 from curvenet.cli import main
-from curvenet.evaluate.metrics import sketch_fidelity
+from curvenet.core.fidelity import sketch_fidelity
 from curvenet.route.hybrid import plan_regions
 from curvenet.io.meshes import read_obj_wires
 from curvenet.model.sketch import Sketch
@@ -147,7 +147,7 @@ def _box_mesh():
 
 
 def test_stroke_wires_are_the_strokes_own_stretches_off_the_surface():
-    from curvenet.evaluate.metrics import point_surface_distance
+    from curvenet.core.distance import point_surface_distance
     from curvenet.route.hybrid import stroke_wires
     box = _box_mesh()
     # along the top edge of the cube, then a zigzag away from it

@@ -8,7 +8,7 @@ import pytest
 import curvenet
 from curvenet import Sketch
 from curvenet.datasets import shapes
-from curvenet.evaluate.metrics import evaluate_mesh
+from curvenet.evaluate import evaluate_mesh
 from curvenet.pipeline import AUTO_MIN_COVERAGE
 
 #: a neural budget small enough for CI; the decision, not the quality, is under test here

@@ -8,7 +8,7 @@ import curvenet
 from curvenet.datasets import shapes
 from curvenet.cli import main
 from curvenet.core.errors import SketchFormatError
-from curvenet.evaluate.metrics import evaluate_mesh
+from curvenet.evaluate import evaluate_mesh
 from curvenet.io.sketch import read_sketch
 from curvenet.io.points import JUMP_RATIO, NotCurvesError, jump_ratio, recover_curves
 from curvenet.datasets.shapes import sample_curves

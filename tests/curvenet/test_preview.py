@@ -115,7 +115,7 @@ def test_decimation_keeps_the_surface():
     1.8e-4 after normalising by the longest side 2: Hausdorff < 5e-4 and Chamfer (a mean,
     measured 2.3e-5) < 1e-4.
     """
-    from curvenet.evaluate.metrics import evaluate_mesh
+    from curvenet.evaluate import evaluate_mesh
 
     m = trimesh.creation.icosphere(subdivisions=6)
     m.vertices *= [1.0, 0.8, 0.6]

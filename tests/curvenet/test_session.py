@@ -15,7 +15,8 @@ from curvenet.cycles.gf2 import edge_mask, gf2_rank
 from curvenet.cycles.find import find_patches
 from curvenet.core.errors import InvalidParameterError, NetworkError
 from curvenet.model.patchset import PatchSet, load_network_file
-from curvenet.cycles.session import PatchSession, Suggestion, run_interactive
+from curvenet.cycles.session import PatchSession, Suggestion
+from curvenet.review import run_interactive
 
 
 def true_faces(shape):

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 import torch
 
-from curvenet.evaluate.metrics import point_surface_distance
+from curvenet.core.distance import point_surface_distance
 from curvenet.neural.flow import fit_flow_surface
 from curvenet.neural.losses import normal_loss
 

@@ -1,0 +1,133 @@
+"""Working strokes of the rough snapping and the small polyline tools its steps share.
+
+:class:`Strokes` holds the polylines being snapped with their arc lengths, source ids
+and labels; :func:`sample` draws uniform arc-length samples of all of them at once
+(with the :class:`Flat` lookup table). All lengths are absolute.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..core.geometry import cumulative_length
+from ..core.tolerances import DIVISION_GUARD
+
+__all__ = ["dedup", "clean", "bump", "smoothstep", "Strokes", "Flat", "sample"]
+
+
+# --------------------------------------------------------------------------- small tools
+def dedup(poly, eps):
+    """Drop points within ``eps`` of their predecessor (the last point is kept)."""
+    poly = np.asarray(poly, dtype=np.float64)
+    if len(poly) < 2:
+        return poly
+    d = np.linalg.norm(np.diff(poly, axis=0), axis=1)
+    keep = np.concatenate([[True], d > eps])
+    out = poly[keep]
+    if not keep[-1] and len(out) > 1:
+        out[-1] = poly[-1]
+    return out
+
+
+def clean(poly, eps):
+    """Drop interior points closer than ``eps`` to their predecessor; ends stay exact.
+
+    Removes the needle segments that joins and cuts can leave (their direction is
+    noise and shows as a kink). A run of such points is dropped whole, which only
+    lengthens one segment.
+    """
+    if len(poly) <= 2:
+        return poly
+    keep = np.ones(len(poly), dtype=bool)
+    keep[1:-1] = np.linalg.norm(np.diff(poly[:-1], axis=0), axis=1) >= eps
+    idx = np.flatnonzero(keep)
+    if len(idx) > 2 and np.linalg.norm(poly[-1] - poly[idx[-2]]) < eps:
+        keep[idx[-2]] = False
+    return poly[keep]
+
+
+def bump(x):
+    """C1 bump ``(1 - x^2)^2`` for ``|x| < 1``, else 0: value 1 and slope 0 at 0."""
+    x = np.minimum(np.abs(x), 1.0)
+    return (1.0 - x * x) ** 2
+
+
+def smoothstep(x):
+    x = np.clip(x, 0.0, 1.0)
+    return x * x * (3.0 - 2.0 * x)
+
+
+# --------------------------------------------------------------------------- state
+class Strokes:
+    """Working strokes: polylines, arc lengths, source ids and labels."""
+
+    def __init__(self):
+        self.polys, self.cums, self.srcs, self.labels = [], [], [], []
+
+    def add(self, poly, srcs, label, cum=None):
+        self.polys.append(poly)
+        self.cums.append(cumulative_length(poly) if cum is None else cum)
+        self.srcs.append(tuple(sorted(set(srcs))))
+        self.labels.append(label)
+
+    def set(self, k, poly):
+        self.polys[k] = poly
+        self.cums[k] = cumulative_length(poly)
+
+    def __len__(self):
+        return len(self.polys)
+
+    def length(self, k):
+        return self.cums[k][-1]
+
+
+class Flat:
+    """All strokes concatenated, for vectorised arc-length lookups.
+
+    Stroke ``k``'s points are ``P[first[k]:first[k] + count[k]]``; its arc
+    parameter ``s`` maps to the global parameter ``s + off[k]`` on the
+    concatenated polyline, where consecutive strokes are separated by a gap of
+    ``sep`` (so a lookup never lands on the joining segment's interior).
+    """
+
+    def __init__(self, st):
+        self.count = np.array([len(p) for p in st.polys])
+        self.first = np.concatenate([[0], np.cumsum(self.count)[:-1]])
+        self.P = np.concatenate(st.polys)
+        self.L = np.array([c[-1] for c in st.cums])
+        sep = float(self.L.sum()) + 1.0
+        self.off = np.concatenate([[0.0], np.cumsum(self.L + sep)[:-1]])
+        self.G = np.concatenate([c + o for c, o in zip(st.cums, self.off)])
+
+    def interp(self, k, s):
+        """Points ``(m, 3)`` at arc parameters ``s (m,)`` of strokes ``k (m,)`` (clamped)."""
+        k = np.asarray(k, dtype=np.int64)
+        g = np.clip(np.asarray(s, dtype=np.float64), 0.0, self.L[k]) + self.off[k]
+        j = np.clip(np.searchsorted(self.G, g, side="right") - 1, 0, len(self.G) - 2)
+        seg = self.G[j + 1] - self.G[j]
+        t = np.clip((g - self.G[j]) / np.maximum(seg, DIVISION_GUARD), 0.0, 1.0)  # guard 0-length
+        return self.P[j] + t[:, None] * (self.P[j + 1] - self.P[j])
+
+
+def sample(st, h):
+    """Uniform samples of every stroke at spacing <= h.
+
+    Returns
+    -------
+    (Q, sid, ss, tan, start, flat) : points (M, 3), stroke id (M,), arc parameter (M,),
+        unit tangent (M, 3), ``start (S + 1,)`` with stroke k's samples at
+        ``start[k]:start[k + 1]``, and the :class:`Flat` arc-length table of the strokes.
+    """
+    flat = Flat(st)
+    n = np.maximum(2, np.ceil(flat.L / h).astype(np.int64) + 1)
+    start = np.concatenate([[0], np.cumsum(n)])
+    sid = np.repeat(np.arange(len(n)), n)
+    local = np.arange(start[-1]) - start[sid]
+    ss = local * (flat.L / (n - 1))[sid]
+    ss[start[1:] - 1] = flat.L  # exact ends
+    Q = flat.interp(sid, ss)
+    nxt = np.minimum(np.arange(len(Q)) + 1, start[sid + 1] - 1)
+    prv = np.maximum(np.arange(len(Q)) - 1, start[sid])
+    tan = Q[nxt] - Q[prv]
+    tan /= np.maximum(np.linalg.norm(tan, axis=1, keepdims=True), DIVISION_GUARD)  # guard 0-length
+    return Q, sid, ss, tan, start, flat
