@@ -48,7 +48,7 @@ HYBRID = tuple(f"cassie/{n}" for n in ("01-0-1", "01-1-1", "05-0-1", "05-0-2", "
 def _seams(res, key: str, fmt: str) -> str:
     """One value per neural fill of ``res`` ("-" when there is none)."""
     regions = res.decision.regions if res.decision is not None else []
-    vals = [r.get(key) for r in regions if r["route"] == "neural"]
+    vals = [getattr(r, key) for r in regions if r.route == "neural"]
     return ",".join("-" if v is None else format(v, fmt) for v in vals) or "-"
 
 
@@ -63,7 +63,7 @@ def _row(set_name: str, path: Path) -> dict:
                "wire_share": 0.0, "median": float("nan"), "p95": d["stroke_p95"]}
     route = res.method
     if res.decision is not None and res.decision.regions:
-        route += " (" + ", ".join(sorted({r["route"] for r in res.decision.regions})) + ")"
+        route += " (" + ", ".join(sorted({r.route for r in res.decision.regions})) + ")"
     return {"set": set_name, "sketch": path.name, "route": route, "seconds": f"{seconds:.1f}",
             "surface_1pct": f"{fid['surface']:.3f}", "with_wires_1pct": f"{fid['with_wires']:.3f}",
             "wire_share": f"{fid['wire_share']:.3f}", "median": f"{fid['median']:.2e}",

@@ -65,7 +65,7 @@ def bench_sketch_to_file(sizes, repeats):
     import tempfile
 
     from curvenet.io.sketch import write_sketch
-    from curvenet.model.patchset import save_patchset
+    from curvenet.io.network import write_patches
     from curvenet.pipeline import patches
 
     print(f"\n{'sketch -> PATCHES.json':<24}{'curves':>7}{'patches':>8}{'total s':>9}"
@@ -78,7 +78,7 @@ def bench_sketch_to_file(sizes, repeats):
 
             def run(src=src, dst=dst):
                 ps = patches(src)
-                save_patchset(dst, ps)
+                write_patches(dst, ps)
                 return ps
 
             t, ps = _time(run, repeats)

@@ -46,10 +46,13 @@ _LAZY = {
     "surfacer_names": "route",
     "SurfaceInput": "route",
     "RouteDecision": "route",
-    "load_network_file": "model",
-    "save_network": "model",
-    "save_patchset": "model",
+    "read_patches": "io",
+    "write_patches": "io",
+    "write_network": "io",
 }
+#: earlier names of public functions: alias -> (module, name)
+_ALIASES = {"load_network_file": ("io", "read_patches"), "save_network": ("io", "write_network"),
+            "save_patchset": ("io", "write_patches")}
 #: modules that moved into a subpackage, reachable under their old name
 _MOVED_MODULES = {"shapes": "datasets.shapes", "redraw": "datasets.redraw"}
 
@@ -63,6 +66,9 @@ __all__ = [
 def __getattr__(name):
     if name in _LAZY:
         value = getattr(_import_module(f".{_LAZY[name]}", __name__), name)
+    elif name in _ALIASES:
+        module, new = _ALIASES[name]
+        value = getattr(_import_module(f".{module}", __name__), new)
     elif name in _MOVED_MODULES:
         value = _import_module(f".{_MOVED_MODULES[name]}", __name__)
     else:

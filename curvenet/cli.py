@@ -200,7 +200,7 @@ def build_parser() -> argparse.ArgumentParser:
 # --------------------------------------------------------------------------- commands
 def _cmd_snap(args) -> int:
     from .io.sketch import read_sketch, write_network_obj
-    from .model.patchset import save_network
+    from .io.network import write_network
     from .snap.graph import snap
     check_output_path(args.output, inputs=[args.input], what="-o")
     sketch = read_sketch(args.input, points=_points(args))
@@ -211,7 +211,7 @@ def _cmd_snap(args) -> int:
     if args.output.lower().endswith(".obj"):
         write_network_obj(args.output, net)
     else:
-        save_network(args.output, net)
+        write_network(args.output, net)
     print(f"{args.output}: {net.number_of_vertices} vertices, {net.number_of_edges} curves")
     print(net.report["summary"])
     if sketch.metadata.get("point_blocks"):
@@ -220,7 +220,7 @@ def _cmd_snap(args) -> int:
 
 
 def _cmd_patches(args) -> int:
-    from .model.patchset import save_patchset
+    from .io.network import write_patches
     from .pipeline import patches
     check_output_path(args.output, inputs=[args.input], what="-o")
     if args.preview:
@@ -229,7 +229,7 @@ def _cmd_patches(args) -> int:
     if args.interactive:
         from .review import run_interactive
         ps = run_interactive(ps, input=sys.stdin, output=sys.stdout, preview=args.preview)
-    save_patchset(args.output, ps)
+    write_patches(args.output, ps)
     t = ps.report.get("timings", {})
     print(f"{args.output}: {len(ps.patches)} patches on {ps.network.number_of_edges} curves "
           f"({sum(t.values()):.2f} s)")
@@ -250,11 +250,11 @@ def _neural_options(args) -> dict | None:
 
 def _surface_one(inp: str, out: str, args) -> dict:
     """Surface one input; returns a status row (never raises CurvenetError)."""
-    from .model.patchset import load_network_file
+    from .io.network import read_patches
     from .pipeline import surface
     t0 = time.perf_counter()
     try:
-        ps = load_network_file(args.patches) if args.patches else None
+        ps = read_patches(args.patches) if args.patches else None
         res = surface(inp, method=args.method, patchset=ps, snap_tol=args.snap_tol,
                       close=args.close, surfacer=args.surfacer, subdiv=args.subdiv,
                       resolution=args.resolution, crease_angle=args.crease_angle,

@@ -1,41 +1,48 @@
 """One pipeline from a sketch file to a surface: snap, find patches, surface.
 
 ``surface(...)`` decides by itself (``method="auto"``) whether the classical
-patch route (Coons -> Catmull-Clark limit fit, :mod:`surfacing`) or the neural
-route (flow-aligned implicit, :mod:`neural`) serves the sketch better, and says
-why in ``SurfaceResult.decision`` (a :class:`~curvenet.route.RouteDecision`; its
-sentence is ``SurfaceResult.diagnostics["decision"]``). The surfacers themselves
-come from the registry of :mod:`curvenet.route.registry`.
+patch route (Coons -> Catmull-Clark limit fit, :mod:`curvenet.surfacing`), the neural
+route (flow-aligned implicit, :mod:`curvenet.neural`) or the hybrid route (patches and
+a neural fill per region) serves the sketch better, and says why in
+``SurfaceResult.decision`` (a :class:`~curvenet.route.RouteDecision`; its sentence is
+``SurfaceResult.diagnostics["decision"]``). The surfacers themselves come from the
+registry of :mod:`curvenet.route`.
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
-from .core.atomic import atomic_path
 from .cad.export import CAD_FORMATS
+from .core.errors import CurvenetError, InvalidParameterError
+from .core.fidelity import sketch_fidelity
 from .core.result import MeshResult
-from .core.errors import CurvenetError, InvalidParameterError, SketchFormatError
+from .io.common import require_file
+from .io.meshes import MESH_FORMATS, write_mesh, write_routed
+from .io.network import read_patches
 from .model.network import CurveNetwork
-from .model.patchset import PatchSet, load_network_file
-from .route.decision import AUTO_MIN_COVERAGE, RouteDecision, coverage, region_route
+from .model.patchset import PatchSet
 from .model.sketch import Sketch
-from .route.registry import (SurfaceInput, SurfaceSettings, Surfacer, get_surfacer,
-                        surfacer_names)
+from .route import (AUTO_MIN_COVERAGE, Region, Route, RouteDecision, SurfaceInput,
+                    SurfaceSettings, Surfacer, coverage, get_surfacer, region_route,
+                    surfacer_names)
+from .route.regions import plan_regions
+from .route.wires import stroke_wires
 
 __all__ = ["SurfaceResult", "surface", "patches", "load_source", "MESH_FORMATS", "CAD_FORMATS",
            "AUTO_MIN_COVERAGE", "write_mesh", "export_cad"]
 
-MESH_FORMATS = (".obj", ".ply", ".stl", ".off", ".glb")
 #: methods that name a route; every registered surfacer name is a method too
 METHODS = ("auto", "classical")
 QUALITIES = ("draft", "default", "paper")
 #: the surfacer of the neural route (auto's fallback, and ``refine``)
 STROKE_SURFACER = "neural"
+#: the composite surfacer of the hybrid route (patches, and a neural fill per region)
+REGION_SURFACER = "hybrid"
 
 
 @dataclass
@@ -64,11 +71,12 @@ class SurfaceResult:
     wires : list of (m, 3) float64
         Stretches of strokes the surface does not pass through (strokes that bound
         nothing, trimmed overshoots, overdrawn strokes), with the strokes' own geometry,
-        kept as polylines beside the mesh (``auto`` only; :func:`curvenet.route.hybrid.add_wires`).
+        kept as polylines beside the mesh (``auto`` only;
+        :func:`curvenet.route.wires.stroke_wires`).
     face_route : (F,) uint8 or None
         Per face, an index into ``routes``: the route that made it.
-    routes : tuple of str
-        Route names of ``face_route`` (``("classical", "neural")``).
+    routes : tuple of Route
+        Routes of ``face_route`` (``(Route.CLASSICAL, Route.NEURAL)``).
     control_net : surfacing.bspline.ControlNet or None
         The Catmull-Clark route's fitted control mesh (what :func:`export_cad` reads);
         ``diagnostics["cad"]`` holds the export report after a STEP / 3DM save.
@@ -107,29 +115,11 @@ class SurfaceResult:
             return Path(path)
         if not self.wires and len(self.routes) < 2:
             return write_mesh(path, self.mesh)
-        from .io.meshes import write_routed
-        _check_format(path)
         return write_routed(path, self.mesh, self.face_route, self.routes, self.wires)
 
     def __repr__(self) -> str:
         return (f"<SurfaceResult(method={self.method!r}, "
                 f"vertices={len(self.mesh.vertices)}, faces={len(self.mesh.faces)})>")
-
-
-def _check_format(path) -> Path:
-    path = Path(path)
-    if path.suffix.lower() not in MESH_FORMATS:
-        raise InvalidParameterError(
-            f"output {path}: unknown mesh format {path.suffix!r}; use one of {MESH_FORMATS}")
-    return path
-
-
-def write_mesh(path, mesh) -> Path:
-    """Write a ``trimesh.Trimesh`` to ``path`` (OBJ / PLY / STL / OFF / GLB) atomically."""
-    path = _check_format(path)
-    with atomic_path(path) as tmp:
-        mesh.export(tmp, file_type=path.suffix.lower()[1:])
-    return path
 
 
 def export_cad(path, result: SurfaceResult, *, schema: str = "AP214",
@@ -150,7 +140,7 @@ def export_cad(path, result: SurfaceResult, *, schema: str = "AP214",
         raise InvalidParameterError(
             f"output {path}: CAD export needs the classical Catmull-Clark route "
             f"(this surface came from {result.method})")
-    foreign = (np.asarray(result.routes)[result.face_route] != "classical"
+    foreign = (np.asarray(result.routes)[result.face_route] != Route.CLASSICAL
                if result.face_route is not None and len(result.routes) else np.zeros(0, bool))
     if foreign.any():
         raise InvalidParameterError(
@@ -199,11 +189,9 @@ def load_source(source, *, points="auto"):
         return None, source
     if isinstance(source, CurveNetwork):
         return None, PatchSet(source)
-    path = Path(source)
-    if not path.is_file():
-        raise SketchFormatError("no such file", path=path)
+    path = require_file(source)
     if _is_network_json(path):
-        return None, load_network_file(path)
+        return None, read_patches(path)
     from .io.sketch import read_sketch
     return read_sketch(path, points=points), None
 
@@ -326,6 +314,7 @@ class _Plan:
 
     patch: Surfacer | None      # the classical route
     stroke: Surfacer | None     # the neural route, or the refinement after the classical one
+    regions: Surfacer | None    # the hybrid route: patches, and a fill per region
     options: dict
     refine: bool                # run ``stroke`` on the result of ``patch``
 
@@ -336,13 +325,22 @@ def _plan(method: str, surfacer: str, refine: bool, settings: SurfaceSettings, *
     _check_settings(method, settings)
     patch = get_surfacer(surfacer, "patches")
     stroke = get_surfacer(STROKE_SURFACER, "strokes")
+    regions = get_surfacer(REGION_SURFACER, "regions")
     if method not in METHODS:
         chosen = get_surfacer(method)
-        patch, stroke = (chosen, stroke) if chosen.needs == "patches" else (None, chosen)
+        if chosen.needs == "regions":
+            regions = chosen
+        elif chosen.needs == "patches":
+            patch = chosen
+        else:
+            patch, stroke = None, chosen
     refine = bool(refine) and patch is not None
     checked = [s for s in (patch, stroke) if s]
-    if method != "auto" and patch is not None and not refine:
-        stroke = None
+    per_region = method in ("auto", regions.name)
+    if not per_region:
+        regions = None
+        if patch is not None and not refine:
+            stroke = None
     stroke_options = dict(neural_options or {})
     if crease_options:
         stroke_options["creases"] = crease_options
@@ -350,7 +348,11 @@ def _plan(method: str, surfacer: str, refine: bool, settings: SurfaceSettings, *
     # options given are checked even for a surfacer this route will not run
     options = {s.name: s.validate(given[s.needs], settings) for s in checked
                if s in (patch, stroke) or given[s.needs]}
-    return _Plan(patch, stroke, options, refine)
+    if regions is not None:
+        options[regions.name] = regions.validate(
+            {"patch": patch.name, "fill": stroke.name, "patch_options": options[patch.name],
+             "fill_options": options[stroke.name]}, settings)
+    return _Plan(patch, stroke, regions, options, refine)
 
 
 def _find_patches(sketch, given, *, snap_tol, close, timings, diag):
@@ -369,28 +371,36 @@ def _find_patches(sketch, given, *, snap_tol, close, timings, diag):
     return net, ps
 
 
+def _regions(ps) -> list:
+    """The patched region, then :func:`~curvenet.route.regions.plan_regions`' regions."""
+    curves = [e.curve for e in ps.network.edges]
+    used = np.zeros(len(curves), bool)
+    used[sorted({i for p in ps.patches for i in p.edges})] = True
+    covered = Region(Route.CLASSICAL, [int(i) for i in np.flatnonzero(used)],
+                     float(sum(ps.network.edges[i].length() for i in np.flatnonzero(used))),
+                     patches=len(ps.patches))
+    return [covered, *plan_regions(curves, used)] if ps.patches else [covered]
+
+
 def _decide(method: str, plan: _Plan, diag: dict, ps) -> RouteDecision:
     """The route: auto's rule per region, or what was requested (with the coverage)."""
     if method == "auto":
-        from .route.hybrid import plan_regions
-        curves = [e.curve for e in ps.network.edges]
-        used = np.zeros(len(curves), bool)
-        used[sorted({i for p in ps.patches for i in p.edges})] = True
-        regions = plan_regions(curves, used) if ps.patches else []
-        covered = {"route": "classical", "curves": [int(i) for i in np.flatnonzero(used)],
-                   "length": float(sum(ps.network.edges[i].length()
-                                       for i in np.flatnonzero(used))),
-                   "patches": len(ps.patches)}
+        covered, *regions = _regions(ps)
         return region_route(diag["patches"], diag["coverage"], regions, covered,
-                            patch_surfacer=plan.patch.name, stroke_surfacer=plan.stroke.name)
-    first = plan.patch or plan.stroke
+                            patch_surfacer=plan.patch.name, stroke_surfacer=plan.stroke.name,
+                            hybrid_surfacer=plan.regions.name)
     sought = {k: diag[k] for k in ("coverage", "patches") if k in diag}
+    if plan.regions is not None:
+        return RouteDecision(method, plan.regions.name, "requested", regions=_regions(ps),
+                             **sought)
+    first = plan.patch or plan.stroke
     return RouteDecision(method, first.name, "requested", **sought)
 
 
 def _classical(plan: _Plan, decision: RouteDecision) -> bool:
-    """Whether the decision takes the route that needs patches (alone or per region)."""
-    return plan.patch is not None and decision.surfacer.split("+")[0] == plan.patch.name
+    """Whether the decision takes a route that needs patches (alone or per region)."""
+    return plan.patch is not None and decision.surfacer in (
+        plan.patch.name, plan.regions.name if plan.regions is not None else None)
 
 
 def _strokes(sketch: Sketch | None, net: CurveNetwork | None):
@@ -401,11 +411,15 @@ def _strokes(sketch: Sketch | None, net: CurveNetwork | None):
 
 
 def _run(surfacer: Surfacer, inp: SurfaceInput, options: dict, timings, diag) -> MeshResult:
-    """Run one surfacer; its seconds and report are filed under its label."""
+    """Run one surfacer; its seconds and report are filed under its label, and those of
+    the parts of a composite (its report's ``parts`` and ``timings``) under theirs."""
     t = time.perf_counter()
     res = surfacer(inp, options)
     timings[surfacer.label] = time.perf_counter() - t
     diag[surfacer.label] = dict(res.report)
+    if "parts" in res.report:
+        diag.update(res.report["parts"])
+        timings.update(res.report["timings"])
     return res
 
 
@@ -419,9 +433,12 @@ def _surface_route(plan: _Plan, decision: RouteDecision, settings: SurfaceSettin
         bounds = orient_boundaries(net, ps.patches)
         inp = SurfaceInput(settings, curves=[e.curve for e in edges],
                            loops=[b[0] for b in bounds], holes=[b[1:] for b in bounds],
-                           crease_curves=[i for i, e in enumerate(edges) if e.label == "crease"])
-        res = _run(plan.patch, inp, plan.options[plan.patch.name], timings, diag)
-        name, init = plan.patch.label, (res.vertices, res.faces)
+                           crease_curves=[i for i, e in enumerate(edges) if e.label == "crease"],
+                           regions=decision.regions)
+        run = plan.patch if decision.surfacer == plan.patch.name else plan.regions
+        res = _run(run, inp, plan.options[run.name], timings, diag)
+        name = run.label if len(res.routes) > 1 else plan.patch.label
+        init = (res.vertices, res.faces)
     if res is None or plan.refine:
         strokes, labels = _strokes(sketch, net)
         inp = SurfaceInput(settings, strokes=strokes, labels=labels, init_mesh=init)
@@ -509,22 +526,17 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
                                timings=timings, diag=diag)
     if len(res.faces) == 0:
         raise CurvenetError(f"the {name} route produced an empty surface")
-    out = SurfaceResult(res.to_trimesh(), name, sketch, net, ps, timings, diag, decision,
-                        control_net=getattr(res, "control_net", None))
-    if decision.regions:
-        from .route.hybrid import assemble
-        assemble(out, res, plan, settings, _run)
-    if method == "auto":
-        from .route.hybrid import add_wires
-        add_wires(out)
-    _fidelity(out)
-    return out
-
-
-def _fidelity(res: SurfaceResult) -> None:
-    """``diagnostics["fidelity"]``: :func:`curvenet.core.fidelity.sketch_fidelity` of the result."""
-    from .core.fidelity import sketch_fidelity
+    if "regions" in res.report:        # a composite filled in its regions' figures
+        decision = replace(decision, regions=[
+            replace(r, **figures) for r, figures in zip(decision.regions, res.report["regions"])])
+    mesh = res.to_trimesh()
+    ref = sketch if sketch is not None else net
+    face_route, routes = res.face_route, tuple(res.routes)
+    wires = stroke_wires(ref, mesh.vertices, mesh.faces) if method == "auto" else []
+    if wires and not routes:
+        face_route, routes = np.zeros(len(mesh.faces), np.uint8), (decision.route,)
     t = time.perf_counter()
-    ref = res.sketch if res.sketch is not None else res.network
-    res.diagnostics["fidelity"] = sketch_fidelity(res.mesh, ref, wires=res.wires)
-    res.timings["fidelity"] = time.perf_counter() - t
+    diag["fidelity"] = sketch_fidelity(mesh, ref, wires=wires)
+    timings["fidelity"] = time.perf_counter() - t
+    return SurfaceResult(mesh, name, sketch, net, ps, timings, diag, decision, wires,
+                         face_route, routes, control_net=getattr(res, "control_net", None))

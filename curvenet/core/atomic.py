@@ -58,7 +58,8 @@ def check_output_path(path, *, inputs=(), what: str = "output"):
 
 
 def _same_file(a: Path, b: Path) -> bool:
-    if a.resolve() == b.resolve():
+    # realpath, not Path.resolve: a symlink loop given as input is for its reader to refuse
+    if os.path.realpath(a) == os.path.realpath(b):
         return True
     try:
         return os.path.samefile(a, b)

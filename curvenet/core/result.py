@@ -27,6 +27,11 @@ class MeshResult:
         Triangles, indices into ``vertices``, consistently oriented.
     report : dict
         Backend diagnostics (timings, deviations, settings); JSON-serialisable values.
+    face_route : (f,) uint8 or None
+        For a surface several surfacers made (a composite such as the hybrid route):
+        per face, an index into ``routes``. None: one surfacer made every face.
+    routes : tuple of str
+        The route of each index of ``face_route`` (empty when it is None).
 
     Examples
     --------
@@ -40,11 +45,19 @@ class MeshResult:
     vertices: np.ndarray
     faces: np.ndarray
     report: dict = field(default_factory=dict)
+    face_route: np.ndarray | None = None
+    routes: tuple = ()
 
     def __post_init__(self):
         # no copy when the arrays already have the documented dtypes
         self.vertices = _rows3(self.vertices, np.float64, "vertices")
         self.faces = _rows3(self.faces, np.int64, "faces")
+        if self.face_route is not None:
+            self.face_route = np.asarray(self.face_route, np.uint8)
+            if self.face_route.shape != (len(self.faces),) or (
+                    len(self.faces) and int(self.face_route.max()) >= len(self.routes)):
+                raise ValueError(f"face_route: expected ({len(self.faces)},) indices into "
+                                 f"routes {tuple(self.routes)}")
 
     def to_trimesh(self):
         """The mesh as a ``trimesh.Trimesh`` (not processed: vertices and faces as they are)."""

@@ -26,9 +26,10 @@ from dataclasses import dataclass, field
 from .gf2 import bitset_solve, edge_mask, gf2_rank, gf2_solve
 from .candidates import DEFAULT_MAX_WORK, TIE_BREAKS, CandidatePool
 from .closing import closing_suggestions
-from ..core.errors import InvalidParameterError, NetworkError, OutputError
+from ..core.errors import InvalidParameterError
 from .loops import cycle_to_loop
-from ..model.patchset import Patch, PatchSet, save_patchset
+from ..io.network import write_patches
+from ..model.patchset import Patch, PatchSet
 
 __all__ = ["Suggestion", "PatchSession"]
 
@@ -264,4 +265,4 @@ class PatchSession:
 
     def save(self, path) -> None:
         """Write the current patch set as ``PATCHES.json`` (atomically)."""
-        save_patchset(path, self.patchset)
+        write_patches(path, self.patchset)

@@ -15,6 +15,7 @@ import math
 import time
 from pathlib import Path
 
+from ..io.common import require_file
 from ..core.errors import CurvenetError, InvalidParameterError, SketchFormatError
 
 __all__ = ["pairs_from_dirs", "pairs_from_csv", "evaluate_pairs", "metric_definitions",
@@ -86,9 +87,7 @@ def pairs_from_csv(path) -> list:
     SketchFormatError
         No such file, no ``mesh``/``reference`` columns, or an empty cell (names the line).
     """
-    path = Path(path)
-    if not path.is_file():
-        raise SketchFormatError("no such file", path=path)
+    path = require_file(path)
     with open(path, newline="", encoding="utf-8", errors="replace") as fh:
         reader = csv.DictReader(fh)
         if not {"mesh", "reference"} <= set(reader.fieldnames or ()):
@@ -130,8 +129,7 @@ def _score(mesh, ref, n_samples, threshold, seed) -> dict:
     if is_mesh_file(ref):
         return {"kind": "mesh", **evaluate_mesh(mesh, ref, n_samples=n_samples,
                                                 threshold=threshold, seed=seed)}
-    if not Path(ref).is_file():
-        raise SketchFormatError("no such file", path=ref)
+    require_file(ref)
     from ..io.sketch import read_sketch
     return {"kind": "sketch", **stroke_distance(mesh, read_sketch(ref))}
 

@@ -15,13 +15,33 @@ from ..core.strokes import LABELS
 from ..core.errors import SketchFormatError
 from ..model.sketch import Sketch
 
-__all__ = ["load_text", "xyz_rows", "parse_rows", "nonfinite_error", "label_of",
-           "finish_sketch", "split_lines", "MAX_ABS_COORDINATE"]
+__all__ = ["load_text", "require_file", "xyz_rows", "parse_rows", "nonfinite_error",
+           "label_of", "finish_sketch", "split_lines", "MAX_ABS_COORDINATE"]
 
 #: Files are read in chunks of this many bytes (the read stops past ``max_bytes``).
 _CHUNK_BYTES = 1 << 20
 #: Largest coordinate magnitude accepted: squared distances of larger ones overflow float64.
 MAX_ABS_COORDINATE = 1e150
+
+
+def require_file(path) -> Path:
+    """``path`` as a ``Path`` when it is a file; else one line saying what it is instead.
+
+    Raises
+    ------
+    SketchFormatError
+        No such file, a folder, or a symbolic link that leads nowhere (a loop of links,
+        or a missing target).
+    """
+    p = Path(path)
+    if p.is_file():
+        return p
+    if p.is_dir():
+        raise SketchFormatError("is a directory, not a file", path=path)
+    if p.is_symlink():
+        raise SketchFormatError("a symbolic link that leads nowhere (a loop of links, or "
+                                "its target is missing)", path=path)
+    raise SketchFormatError("no such file", path=path)
 
 
 def load_text(path, max_bytes: int) -> str:
@@ -33,6 +53,8 @@ def load_text(path, max_bytes: int) -> str:
     p = Path(path)
     if p.is_dir():
         raise SketchFormatError("is a directory, not a sketch file", path=path)
+    if p.is_symlink() and not p.exists():
+        require_file(p)
     chunks, total = [], 0
     try:
         with open(p, "rb") as fh:

@@ -1,6 +1,7 @@
-"""Meshes whose faces carry the route that made them, with wires beside them.
+"""Mesh files: a surface alone, or with the route of each face and wires beside it.
 
-The hybrid route of :func:`curvenet.surface` makes one mesh from several surfacers
+:func:`write_mesh` writes a ``trimesh.Trimesh`` in any of :data:`MESH_FORMATS`. The
+hybrid route of :func:`curvenet.surface` makes one mesh from several surfacers
 (classical patches, a neural fill) and keeps strokes that bound nothing as wires.
 :func:`write_routed` writes that: OBJ with one group per route (``g classical``,
 ``g neural``) and the wires as ``l`` records; PLY with a ``route`` face property
@@ -15,9 +16,29 @@ from pathlib import Path
 import numpy as np
 
 from ..core.atomic import atomic_path
-from ..core.errors import SketchFormatError
+from ..core.errors import InvalidParameterError, SketchFormatError
 
-__all__ = ["write_routed", "read_obj_wires"]
+__all__ = ["MESH_FORMATS", "check_mesh_format", "write_mesh", "write_routed", "read_obj_wires"]
+
+#: Mesh formats written (by extension).
+MESH_FORMATS = (".obj", ".ply", ".stl", ".off", ".glb")
+
+
+def check_mesh_format(path) -> Path:
+    """``path`` as a ``Path`` when its extension is one of :data:`MESH_FORMATS`."""
+    path = Path(path)
+    if path.suffix.lower() not in MESH_FORMATS:
+        raise InvalidParameterError(
+            f"output {path}: unknown mesh format {path.suffix!r}; use one of {MESH_FORMATS}")
+    return path
+
+
+def write_mesh(path, mesh) -> Path:
+    """Write a ``trimesh.Trimesh`` to ``path`` (OBJ / PLY / STL / OFF / GLB) atomically."""
+    path = check_mesh_format(path)
+    with atomic_path(path) as tmp:
+        mesh.export(tmp, file_type=path.suffix.lower()[1:])
+    return path
 
 
 def _obj_text(vertices, faces, face_route, routes, wires) -> str:
@@ -47,7 +68,7 @@ def write_routed(path, mesh, face_route, routes, wires) -> Path:
     ----------
     path : str or os.PathLike
         ``.obj`` (route groups and ``l`` wires), ``.ply`` (``route`` face property),
-        or another format of :data:`curvenet.pipeline.MESH_FORMATS` (the mesh alone).
+        or another of :data:`MESH_FORMATS` (the mesh alone).
     mesh : trimesh.Trimesh
     face_route : (F,) int
         Index into ``routes`` per face.
@@ -56,7 +77,7 @@ def write_routed(path, mesh, face_route, routes, wires) -> Path:
     wires : list of (m, 3) float64
         Polylines written beside the mesh (OBJ only).
     """
-    path = Path(path)
+    path = check_mesh_format(path)
     ext = path.suffix.lower()
     with atomic_path(path) as tmp:
         if ext == ".obj":

@@ -1,32 +1,19 @@
-"""Patch sets: cycles of a curve network chosen as surface patches, and their JSON files.
+"""Patch sets: cycles of a curve network chosen as surface patches.
 
-File layout (``PATCHES.json``, format version 1; ``NETWORK.json`` is the same
-without ``patches`` and with ``"format": "curvenet.network"``)::
-
-    {"format": "curvenet.patches", "version": 1,
-     "vertices": [[x, y, z], ...],
-     "edges":    [{"u": 0, "v": 3, "curve": [[x, y, z], ...]}, ...],
-     "patches":  [{"edges": [0, 4, 7, 2], "source": "auto" | "closing" | "user",
-                   "holes": [[9, 10, 11], ...]}, ...]}
-
-``holes`` is optional (absent: a patch bounded by one loop): the edge cycles of
-the inner boundary loops of a face with holes, ``edges`` being its outer loop;
-in the cycle space the face is the sum of all of them. Readers that ignore
-``holes`` see the outer loop as a filled patch.
+A :class:`Patch` is an edge cycle (its outer loop) and, for a face with holes, the
+edge cycles of its inner loops; in the cycle space the face is the sum of all of
+them. ``PatchSet.to_dict`` / ``from_dict`` are the ``PATCHES.json`` layout, which
+:mod:`curvenet.io.network` reads and writes.
 """
 
 from __future__ import annotations
 
-import json
 from dataclasses import dataclass, field
-from pathlib import Path
 
-from ..core.atomic import atomic_write_text
 from ..core.errors import SketchFormatError
 from .network import CurveNetwork
 
-__all__ = ["Patch", "PatchSet", "PATCH_SOURCES", "save_patchset", "save_network",
-           "load_network_file"]
+__all__ = ["Patch", "PatchSet", "PATCH_SOURCES"]
 
 PATCH_SOURCES = ("auto", "closing", "user")
 
@@ -110,40 +97,3 @@ class PatchSet:
                 raise SketchFormatError(f"patches[{i}]: unknown source {source!r}", path=path)
             patches.append(Patch(tuple(edges), source, tuple(map(tuple, holes))))
         return cls(net, patches)
-
-
-def save_network(path, network: CurveNetwork) -> None:
-    """Write ``NETWORK.json`` atomically."""
-    atomic_write_text(path, json.dumps(network.to_dict()))
-
-
-def save_patchset(path, patchset: PatchSet) -> None:
-    """Write ``PATCHES.json`` atomically."""
-    atomic_write_text(path, json.dumps(patchset.to_dict()))
-
-
-def load_network_file(path) -> PatchSet:
-    """Read a ``NETWORK.json`` or ``PATCHES.json`` file as a :class:`PatchSet`.
-
-    A network file gives a patch set with no patches.
-
-    Raises
-    ------
-    SketchFormatError
-        Not JSON, or not one of the two curvenet formats / versions.
-    """
-    path = Path(path)
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except json.JSONDecodeError as err:
-        raise SketchFormatError(f"invalid JSON: {err.msg}", path=path, line=err.lineno) from None
-    except (OSError, UnicodeDecodeError) as err:
-        raise SketchFormatError(f"cannot read: {err}", path=path) from None
-    if not isinstance(data, dict) or data.get("format") not in ("curvenet.network",
-                                                                 "curvenet.patches"):
-        raise SketchFormatError("not a curvenet network or patch file (missing 'format')",
-                                path=path)
-    if data.get("version") != 1:
-        raise SketchFormatError(f"unsupported version {data.get('version')!r} (expected 1)",
-                                path=path)
-    return PatchSet.from_dict(data, path=path)

@@ -1,20 +1,21 @@
 """Which surfacer serves a sketch, and why: the route decision as data.
 
 :func:`curvenet.surface` fills a :class:`RouteDecision`; :meth:`RouteDecision.explain`
-turns it into the sentence ``curvenet surface --explain`` prints. ``regions`` is kept
-for decisions made per region of the network (one entry per region).
+turns it into the sentence ``curvenet surface --explain`` prints. A decision made per
+region of the network (``auto``) lists its :class:`Region` s, the patched one first.
 """
 
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
+from enum import Enum
 
 import numpy as np
 
 from ..model.patchset import PatchSet
 
-__all__ = ["AUTO_MIN_COVERAGE", "MAX_WIRE_SHARE", "RouteDecision", "REASONS", "coverage",
-           "auto_route", "region_route"]
+__all__ = ["Route", "Region", "AUTO_MIN_COVERAGE", "MAX_WIRE_SHARE", "RouteDecision", "REASONS",
+           "coverage", "auto_route", "region_route"]
 
 #: auto mode takes the classical route when at least this fraction of the
 #: network's curve length lies on curves used by some patch.
@@ -23,6 +24,84 @@ AUTO_MIN_COVERAGE = 0.8
 #: the per-region route keeps the curves that bound nothing as wires only while they
 #: carry at most this fraction of the curve length (else auto's per-sketch rule holds)
 MAX_WIRE_SHARE = 0.5
+
+
+class Route(str, Enum):
+    """The routes a surface (or a part of it) can take.
+
+    A ``str`` subclass: ``Route.CLASSICAL == "classical"``, and it prints, formats and
+    serialises to JSON as its value.
+
+    Examples
+    --------
+    >>> Route("neural"), f"{Route.HYBRID}", Route.CLASSICAL == "classical"
+    (<Route.NEURAL: 'neural'>, 'hybrid', True)
+    """
+
+    CLASSICAL = "classical"   # patches, surfaced from their boundary curves
+    NEURAL = "neural"         # an implicit surface fitted to the strokes
+    HYBRID = "hybrid"         # patches, and a neural fill for the regions no patch covers
+    WIRES = "wires"           # strokes kept as polylines, no surface
+
+    def __str__(self) -> str:
+        return self.value
+
+    def __format__(self, spec: str) -> str:
+        return format(self.value, spec)
+
+
+@dataclass
+class Region:
+    """A group of network curves and the route auto chose for it.
+
+    Attributes
+    ----------
+    route : Route
+        ``CLASSICAL`` (the curves some patch uses), ``NEURAL`` (a surface-like region of
+        unused curves: a neural fill) or ``WIRES``.
+    curves : list of int
+        Curve (edge) ids of the network.
+    length : float
+        Their curve length, input units.
+    patches : int or None
+        Patches of the classical region (None for the others).
+    fill, spread : float or None
+        The figures of the surface-like test (:func:`curvenet.route.regions.plan_regions`):
+        share of the region's convex hull near a curve, short over long side.
+    faces, anchors : int or None
+        A fill's kept faces and the patch samples it was fitted with (after surfacing).
+    seam_fit, seam, seam_fit_p95, seam_p95, seam_moved : float or None
+        Where a fill meets the patches (:func:`curvenet.route.hybrid.fill_seam`) before
+        and after its boundary is moved onto them, and the longest move (fractions of
+        the network's diagonal; shares for ``seam_fit``, ``seam``).
+    """
+
+    route: Route
+    curves: list
+    length: float
+    patches: int | None = None
+    fill: float | None = None
+    spread: float | None = None
+    faces: int | None = None
+    anchors: int | None = None
+    seam_fit: float | None = None
+    seam: float | None = None
+    seam_fit_p95: float | None = None
+    seam_p95: float | None = None
+    seam_moved: float | None = None
+
+    def __post_init__(self):
+        self.route = Route(self.route)
+
+    def explain(self, total: float) -> str:
+        """``"<route>: <n> curves, <share> of the curve length ..."``, ``total`` the whole
+        network's curve length; a fill also says how it meets the patches."""
+        return (f"{self.route}: {len(self.curves)} curves, {self.length / total:.0%} of the "
+                f"curve length" + (f" ({self.patches} patches)" if self.patches is not None
+                                   else "")
+                + (f"; meets the patches along {self.seam:.0%} of the shared curves it "
+                   f"reaches" if self.seam is not None else ""))
+
 
 #: reason code -> sentence (``str.format`` over the decision's fields)
 REASONS = {
@@ -45,29 +124,29 @@ class RouteDecision:
 
     Attributes
     ----------
-    method : str
-        ``"classical"`` or ``"neural"`` (what ``auto`` chose), or the method requested.
+    route : Route or str
+        The route auto chose, or the method requested (a surfacer's name).
     surfacer : str
-        Registry name of the surfacer that ran (:mod:`curvenet.route.registry`).
+        Registry name of the surfacer that runs (:mod:`curvenet.route.registry`); the
+        hybrid route's is the composite ``"hybrid"``.
     reason : str
-        A key of :data:`REASONS`: ``"requested"``, ``"no_cycles"``, ``"low_coverage"``
-        or ``"covered"``.
+        A key of :data:`REASONS`.
     coverage : float or None
         Fraction of the curve length on curves some patch uses (None: no patches sought).
     patches : int or None
         Number of patches found (None: no patches sought).
     min_coverage : float
         The auto threshold the coverage was compared with.
-    regions : list
-        Per-region decisions, for routes that choose per region (empty otherwise).
+    regions : list of Region
+        Per-region routes, the patched region first (empty unless auto chose per region).
 
     Examples
     --------
-    >>> RouteDecision("classical", "catmull-clark", "covered", 1.0, 6).explain()
+    >>> RouteDecision(Route.CLASSICAL, "catmull-clark", "covered", 1.0, 6).explain()
     'classical: 6 patches cover 100% of the curve length (>= 80%)'
     """
 
-    method: str
+    route: Route | str
     surfacer: str
     reason: str
     coverage: float | None = None
@@ -75,22 +154,18 @@ class RouteDecision:
     min_coverage: float = AUTO_MIN_COVERAGE
     regions: list = field(default_factory=list)
 
+    def __post_init__(self):
+        if self.route in Route._value2member_map_:
+            self.route = Route(self.route)
+
     def explain(self) -> str:
-        """``"<method>: <why>"``, the sentence ``--explain`` prints."""
-        return f"{self.method}: " + REASONS[self.reason].format(**asdict(self))
+        """``"<route>: <why>"``, the sentence ``--explain`` prints."""
+        return f"{self.route}: " + REASONS[self.reason].format(**asdict(self))
 
     def explain_regions(self) -> list:
-        """One line per region: ``"<route>: <n> curves, <share> of the curve length"``.
-
-        A neural fill's line also says along what share of the patch curves it reaches
-        it meets the patches (``seam``, :func:`curvenet.route.hybrid.fill_seam`).
-        """
-        total = sum(r["length"] for r in self.regions) or 1.0
-        return [f"{r['route']}: {len(r['curves'])} curves, {r['length'] / total:.0%} of the "
-                f"curve length" + (f" ({r['patches']} patches)" if "patches" in r else "")
-                + (f"; meets the patches along {r['seam']:.0%} of the shared curves it "
-                   f"reaches" if r.get("seam") is not None else "")
-                for r in self.regions]
+        """One line per region (:meth:`Region.explain`)."""
+        total = sum(r.length for r in self.regions) or 1.0
+        return [r.explain(total) for r in self.regions]
 
 
 def coverage(ps: PatchSet) -> tuple[float, list]:
@@ -119,16 +194,16 @@ def auto_route(n_patches: int, cov: float, *, patch_surfacer: str, stroke_surfac
     """
     common = dict(coverage=cov, patches=n_patches, min_coverage=min_coverage)
     if not n_patches:
-        return RouteDecision("neural", stroke_surfacer, "no_cycles", **common)
+        return RouteDecision(Route.NEURAL, stroke_surfacer, "no_cycles", **common)
     if cov < min_coverage:
-        return RouteDecision("neural", stroke_surfacer, "low_coverage", **common)
-    return RouteDecision("classical", patch_surfacer, "covered", **common)
+        return RouteDecision(Route.NEURAL, stroke_surfacer, "low_coverage", **common)
+    return RouteDecision(Route.CLASSICAL, patch_surfacer, "covered", **common)
 
 
-def region_route(n_patches: int, cov: float, regions: list, covered: dict, *,
-                 patch_surfacer: str, stroke_surfacer: str,
+def region_route(n_patches: int, cov: float, regions: list, covered: Region, *,
+                 patch_surfacer: str, stroke_surfacer: str, hybrid_surfacer: str = "hybrid",
                  min_coverage: float = AUTO_MIN_COVERAGE) -> RouteDecision:
-    """Auto's rule per region (:func:`curvenet.route.hybrid.plan_regions` made ``regions``).
+    """Auto's rule per region (:func:`curvenet.route.regions.plan_regions` made ``regions``).
 
     Patches where cycles exist; the neural route alone when there are none, or when the
     surface-like regions carry more curve length than the patches; auto's per-sketch
@@ -137,19 +212,19 @@ def region_route(n_patches: int, cov: float, regions: list, covered: dict, *,
 
     Parameters
     ----------
-    regions : list of dict
-        Regions of the curves no patch uses (``route``, ``curves``, ``length``).
-    covered : dict
-        The classical region: ``route="classical"``, ``curves``, ``length``, ``patches``.
+    regions : list of Region
+        Regions of the curves no patch uses.
+    covered : Region
+        The classical region: the curves the patches use.
 
     Examples
     --------
-    >>> wire = {"route": "wires", "curves": [7], "length": 1.0}
-    >>> patched = {"route": "classical", "curves": [0, 1, 2], "length": 3.0, "patches": 1}
+    >>> wire = Region(Route.WIRES, [7], 1.0)
+    >>> patched = Region(Route.CLASSICAL, [0, 1, 2], 3.0, patches=1)
     >>> d = region_route(1, 0.75, [wire], patched, patch_surfacer="catmull-clark",
     ...                  stroke_surfacer="neural")
-    >>> d.method
-    'classical'
+    >>> d.route
+    <Route.CLASSICAL: 'classical'>
     >>> print(*d.explain_regions(), sep=chr(10))
     classical: 3 curves, 75% of the curve length (1 patches)
     wires: 1 curves, 25% of the curve length
@@ -158,17 +233,17 @@ def region_route(n_patches: int, cov: float, regions: list, covered: dict, *,
                       stroke_surfacer=stroke_surfacer, min_coverage=min_coverage)
     if not n_patches or not regions:
         return base
-    total = covered["length"] + sum(r["length"] for r in regions)
-    fill = sum(r["length"] for r in regions if r["route"] == "neural")
-    wires = sum(r["length"] for r in regions if r["route"] == "wires")
+    total = covered.length + sum(r.length for r in regions)
+    fill = sum(r.length for r in regions if r.route is Route.NEURAL)
+    wires = sum(r.length for r in regions if r.route is Route.WIRES)
     common = dict(coverage=cov, patches=n_patches, min_coverage=min_coverage,
                   regions=[covered] + regions)
-    if fill > covered["length"]:
+    if fill > covered.length:
         common["regions"] = []
-        return RouteDecision("neural", stroke_surfacer, "unstructured", **common)
+        return RouteDecision(Route.NEURAL, stroke_surfacer, "unstructured", **common)
     if wires > MAX_WIRE_SHARE * total:
         return base
     if not fill:
         reason = "covered" if cov >= min_coverage else "hybrid"
-        return RouteDecision("classical", patch_surfacer, reason, **common)
-    return RouteDecision("hybrid", f"{patch_surfacer}+{stroke_surfacer}", "hybrid", **common)
+        return RouteDecision(Route.CLASSICAL, patch_surfacer, reason, **common)
+    return RouteDecision(Route.HYBRID, hybrid_surfacer, "hybrid", **common)

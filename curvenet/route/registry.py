@@ -8,21 +8,24 @@ MeshResult``:
   patches first.
 - ``needs="strokes"``: the labelled strokes (``inp.strokes``, ``inp.labels``) and, when
   it refines an earlier surface, ``inp.init_mesh``.
+- ``needs="regions"``: a composite of a patch surfacer and a stroke surfacer (the
+  hybrid route): what ``"patches"`` gets and ``inp.regions``, the regions of the
+  network with their routes.
 
 An optional ``check(options, settings)`` validates the surfacer's own options before
 the pipeline does any work and raises :class:`~curvenet.core.errors.InvalidParameterError`
 naming the bad one. Everything else a surfacer raises is an internal error.
 
 Entries name their function as ``"module:function"`` (resolved on first use) or pass
-it directly; the built-in entries import their backend inside the function, so importing
-this module imports neither backend, and never torch. Adding a surfacer is one module
-with the function and one :func:`register_surfacer` line at the end of this file.
+it directly. The built-in entries (:mod:`curvenet.route.builtins`, registered when
+:mod:`curvenet.route` is imported) import their backend inside the function, so the
+registry imports neither backend, and never torch. Adding a surfacer is one function
+and one :func:`register_surfacer` call.
 """
 
 from __future__ import annotations
 
 import importlib
-import inspect
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -30,10 +33,11 @@ from ..core.result import MeshResult
 from ..core.errors import InvalidParameterError
 
 __all__ = ["NEEDS", "SurfaceSettings", "SurfaceInput", "Surfacer", "register_surfacer",
-           "unregister_surfacer", "get_surfacer", "surfacer_names"]
+           "unregister_surfacer", "get_surfacer", "surfacer_names", "check_option_names"]
 
-#: What a surfacer may need: patch loops on the snapped network, or the strokes.
-NEEDS = ("patches", "strokes")
+#: What a surfacer may need: patch loops on the snapped network, the strokes, or patch
+#: loops and the network's regions (a composite).
+NEEDS = ("patches", "strokes", "regions")
 #: Method names the pipeline reserves for its routes (see :func:`curvenet.surface`).
 _RESERVED = ("auto", "classical")
 
@@ -91,7 +95,11 @@ class SurfaceInput:
         A surface to refine (``needs="strokes"``, refinement only).
     anchors : tuple of ((m, 3) float64, (m, 3) float64) or None
         Points and unit normals of a surface the result must meet (``needs="strokes"``:
-        the classical patches beside a hybrid fill, :func:`curvenet.route.hybrid.patch_anchors`).
+        the classical patches beside a hybrid fill,
+        :func:`curvenet.route.hybrid.patch_anchors`).
+    regions : list of curvenet.route.Region
+        The regions of a per-region route, the patched one first (the composite
+        ``"hybrid"`` surfacer; empty otherwise).
     """
 
     settings: SurfaceSettings = field(default_factory=SurfaceSettings)
@@ -103,6 +111,7 @@ class SurfaceInput:
     labels: list = field(default_factory=list)
     init_mesh: tuple | None = None
     anchors: tuple | None = None
+    regions: list = field(default_factory=list)
 
 
 def _resolve(ref):
@@ -123,7 +132,7 @@ class Surfacer:
         Registry key; also a ``method`` of :func:`curvenet.surface` and ``--method``.
     run : callable or str
         ``run(inp: SurfaceInput, options: dict) -> MeshResult``, or ``"module:function"``.
-    needs : {"patches", "strokes"}
+    needs : {"patches", "strokes", "regions"}
     label : str
         The method name results carry (``SurfaceResult.method``) and the key of its
         timings and report in the pipeline result.
@@ -173,7 +182,7 @@ def register_surfacer(name: str, run: Callable | str | None = None, *, needs: st
         ``run(inp: SurfaceInput, options: dict) -> MeshResult`` or ``"module:function"``
         (imported on first use). Omitted: returns a decorator that registers the
         function it decorates.
-    needs : {"patches", "strokes"}
+    needs : {"patches", "strokes", "regions"}
         What the pipeline prepares for it.
     label : str, optional
         Method name of its results (default ``name``).
@@ -243,118 +252,9 @@ def surfacer_names(needs: str | None = None) -> tuple:
     return tuple(n for n, s in _REGISTRY.items() if needs is None or s.needs == needs)
 
 
-# --------------------------------------------------------------------------- built-ins
-def _check_names(surfacer: str, options: dict, valid) -> None:
+def check_option_names(surfacer: str, options: dict, valid) -> None:
+    """Refuse options of ``surfacer`` that are not in ``valid`` (one line naming them)."""
     unknown = sorted(set(options) - set(valid))
     if unknown:
         raise InvalidParameterError(f"{surfacer}: unknown option(s) {unknown}; "
                                     f"valid: {sorted(valid)}")
-
-
-#: surface_loops arguments the pipeline fills from the network and the settings
-_FROM_PIPELINE = ("crease_curves", "crease_angle")
-
-
-def _loops_kwargs(options: dict, settings: SurfaceSettings) -> dict:
-    """Options with the explicit ``subdiv`` / ``resolution`` settings on top."""
-    kw = dict(options)
-    if settings.subdiv is not None:
-        kw["subdiv"] = settings.subdiv
-    if settings.resolution is not None:
-        kw["resolution"] = settings.resolution
-    return kw
-
-
-def _check_catmull_clark(options: dict, settings: SurfaceSettings) -> None:
-    from ..surfacing import check_loops_options, surface_loops
-    params = inspect.signature(surface_loops).parameters.values()
-    _check_names("catmull-clark", options, [p.name for p in params if p.kind is p.KEYWORD_ONLY
-                                            and p.name not in _FROM_PIPELINE])
-    check_loops_options(**_loops_kwargs(options, settings))
-
-
-def _boundaries(inp: SurfaceInput) -> list:
-    """Per patch ``[outer loop, hole loops...]``."""
-    holes = inp.holes or [[] for _ in inp.loops]
-    return [[lp, *h] for lp, h in zip(inp.loops, holes)]
-
-
-def _catmull_clark(inp: SurfaceInput, options: dict) -> MeshResult:
-    from ..surfacing.holes import surface_boundaries
-    return surface_boundaries(inp.curves, _boundaries(inp), crease_curves=inp.crease_curves,
-                              crease_angle=inp.settings.crease_angle,
-                              **_loops_kwargs(options, inp.settings))
-
-
-def _check_soapfilm(options: dict, settings: SurfaceSettings) -> None:
-    _check_names("soapfilm", options, ["resolution"])
-    res = options.get("resolution", 1)
-    try:
-        good = int(res) >= 1
-    except (TypeError, ValueError):     # not a number at all
-        good = False
-    if not good:
-        raise InvalidParameterError(f"resolution: expected >= 1, got {res!r}")
-
-
-def _soapfilm(inp: SurfaceInput, options: dict) -> MeshResult:
-    from ..surfacing import soapfilm_loops
-    from ..surfacing.holes import split_boundaries
-    curves, loops, _, _ = split_boundaries(inp.curves, _boundaries(inp))
-    return soapfilm_loops(curves, loops, **options)
-
-
-def _check_neural(options: dict, settings: SurfaceSettings) -> None:
-    """Flow settings (:class:`neural.presets.FlowConfig` fields) and, under ``"creases"``,
-    the crease refit's (:class:`neural.creases.CreaseConfig` fields)."""
-    from ..neural.presets import get_config
-    flow = dict(options)
-    creases = flow.pop("creases", None)
-    try:
-        get_config(settings.quality, **flow)
-    except ValueError as err:
-        raise InvalidParameterError(f"neural_options: {err}") from err
-    if creases:
-        from ..neural.creases import crease_config
-        try:
-            crease_config(settings.quality, creases)
-        except ValueError as err:
-            raise InvalidParameterError(f"crease_options: {err}") from err
-
-
-def _neural(inp: SurfaceInput, options: dict) -> MeshResult:
-    """Flow-aligned implicit fit, then the crease refit when some strokes are creases."""
-    from ..neural import creases, flow
-    s = inp.settings
-    _check_device(s.device)
-    flow_options = dict(options)
-    crease_options = flow_options.pop("creases", None) or {}
-    res = flow.fit_flow_surface(inp.strokes, labels=inp.labels, quality=s.quality,
-                                device=s.device, seed=s.seed, init_mesh=inp.init_mesh,
-                                anchors=inp.anchors, progress=s.progress, **flow_options)
-    verts, faces, report = res.vertices, res.faces, dict(res.report)
-    if "crease" in inp.labels and not report.get("interrupted"):
-        cres = creases.crease_refine(verts, faces, inp.strokes, inp.labels, quality=s.quality,
-                                     device=s.device, seed=s.seed, progress=s.progress,
-                                     **crease_options)
-        verts, faces = cres.vertices, cres.faces
-        report["creases"] = dict(cres.report)
-    return MeshResult(verts, faces, report)
-
-
-def _check_device(device: str) -> None:
-    """A CUDA device asked for on a machine without one is bad input, not a failure."""
-    if str(device).startswith("cuda"):
-        import torch
-        if not torch.cuda.is_available():
-            raise InvalidParameterError(f"device: {device!r} requested but CUDA is not "
-                                        f"available")
-
-
-register_surfacer("catmull-clark", _catmull_clark, needs="patches", label="classical",
-                  check=_check_catmull_clark,
-                  summary="Coons patches -> Catmull-Clark limit surface fitted to the curves")
-register_surfacer("soapfilm", _soapfilm, needs="patches", check=_check_soapfilm,
-                  summary="soap-film baseline, a minimal surface per patch")
-register_surfacer("neural", _neural, needs="strokes", check=_check_neural,
-                  summary="flow-aligned implicit surface fitted to the strokes, with torch")

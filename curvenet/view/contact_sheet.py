@@ -2,11 +2,11 @@
 
 The tiles are the small pictures :func:`curvenet.batch.run_batch` writes into the preview
 folder (rendered by :func:`curvenet.view.preview.render_preview` on the workers). Each tile's
-frame and caption are coloured by the route the file took (:data:`ROUTE_COLOURS`), so a
-mixed batch shows at a glance which files went classical, neural or hybrid; inside a
-tile the faces are coloured by the route that made them and the wires drawn
-(:data:`curvenet.view.preview.ROUTE_COLOURS`). Failed files get a red, empty tile with the
-error's first words.
+frame and caption are coloured by the route the file took, so a mixed batch shows at
+a glance which files went classical, neural or hybrid; inside a tile the faces are
+coloured by the route that made them and the wires drawn (the same colours,
+:data:`curvenet.view.colours.ROUTE_COLOURS`). Failed files get a red, empty tile with
+the error's first words.
 """
 
 from __future__ import annotations
@@ -16,21 +16,23 @@ from pathlib import Path
 
 from ..core.atomic import atomic_path
 from ..core.errors import InvalidParameterError
+from .colours import FAILED_COLOUR, ROUTE_COLOURS
 
-__all__ = ["contact_sheet", "ROUTE_COLOURS"]
-
-#: Frame colour per route (the part of ``route`` before any ``+``) and for failures.
-ROUTE_COLOURS = {"classical": "#1f4e9c", "soapfilm": "#2a8a4a", "neural": "#d9730d",
-                 "hybrid": "#7b3fa0", "failed": "#c0262d"}
+__all__ = ["contact_sheet"]
 
 #: Tile width and height in inches at 100 dpi, and the number of columns at most.
 TILE_INCHES, MAX_COLUMNS = (2.4, 2.3), 6
 
 
 def _route_key(row: dict) -> str:
+    """The row's route (its surfacer's label without a ``+refine``), or ``"failed"``."""
     if row.get("status") not in ("ok", "skipped"):
         return "failed"
-    return str(row.get("route") or "classical").split("+")[0]
+    return str(row.get("route") or "classical").removesuffix("+refine")
+
+
+def _colour(key: str):
+    return FAILED_COLOUR if key == "failed" else ROUTE_COLOURS.get(key, (0.0, 0.0, 0.0))
 
 
 def _caption(row: dict) -> str:
@@ -82,9 +84,9 @@ def contact_sheet(path, rows, tiles_dir, *, title: str | None = None) -> Path:
         ax.set_xticks([])
         ax.set_yticks([])
         for spine in ax.spines.values():
-            spine.set_edgecolor(ROUTE_COLOURS.get(key, "black"))
+            spine.set_edgecolor(_colour(key))
             spine.set_linewidth(3)
-        ax.set_title(_caption(row), fontsize=7, color=ROUTE_COLOURS.get(key, "black"))
+        ax.set_title(_caption(row), fontsize=7, color=_colour(key))
     fig.suptitle(title or ", ".join(f"{v} {k}" for k, v in sorted(counts.items())),
                  fontsize=10)
     fig.subplots_adjust(left=0.01, right=0.99, bottom=0.01, top=1 - 0.45 / fig.get_figheight(),

@@ -14,12 +14,13 @@ from pathlib import Path
 import numpy as np
 
 from ..core.atomic import atomic_path
+from ..core.errors import InvalidParameterError
 from ..core.geometry import as_polyline
 from ..core.tolerances import COINCIDENT_REL, DIVISION_GUARD, ZERO_LENGTH
-from ..core.errors import InvalidParameterError
+from .colours import ROUTE_COLOURS, WIRE_COLOUR
 
 __all__ = ["render_preview", "patch_polygons", "decimate_clustering", "DEFAULT_VIEWS",
-           "MAX_PREVIEW_FACES", "ROUTE_COLOURS", "WIRE_COLOUR"]
+           "MAX_PREVIEW_FACES"]
 
 #: Default camera(s): ``(elevation, azimuth)`` in degrees, one panel each (front and back).
 DEFAULT_VIEWS = ((20.0, -60.0), (20.0, 120.0))
@@ -47,10 +48,6 @@ _STROKE_COLOUR = (0.25, 0.25, 0.25)
 _CONSTRUCTION_COLOUR = (0.65, 0.65, 0.65)
 _EDGE_COLOURS = {"boundary": (0.12, 0.23, 0.45), "crease": (0.75, 0.22, 0.17)}
 _MESH_COLOUR = np.array([0.72, 0.76, 0.82])
-#: Face colour per route of a routed surface (``face_route``); other routes are grey.
-ROUTE_COLOURS = {"classical": (0.55, 0.68, 0.88), "neural": (0.93, 0.60, 0.32)}
-#: Wires (strokes kept beside the surface).
-WIRE_COLOUR = (0.10, 0.55, 0.25)
 #: Highlight (a suggested patch): saturated orange, not produced by the patch palette
 #: (its saturation is 0.45), so tests can find it in the picture.
 HIGHLIGHT_COLOUR = (1.0, 0.45, 0.0)

@@ -134,10 +134,9 @@ def test_report_rows_and_contact_sheet(tmp_path):
     assert res.rows[4]["status"] == "error" and "bad.obj:1" in res.rows[4]["error"]
     from matplotlib.image import imread
 
-    from curvenet.view.contact_sheet import ROUTE_COLOURS
+    from curvenet.view.colours import FAILED_COLOUR, ROUTE_COLOURS
     img = imread(tmp_path / "prev" / "contact_sheet.png")[..., :3]
-    for key in ("classical", "failed"):
-        rgb = np.array([int(ROUTE_COLOURS[key][i:i + 2], 16) / 255 for i in (1, 3, 5)])
+    for key, rgb in (("classical", ROUTE_COLOURS["classical"]), ("failed", FAILED_COLOUR)):
         assert np.sum(np.all(np.abs(img - rgb) < 0.02, axis=-1)) > 500, key  # frames
     assert sorted(p.name for p in (tmp_path / "prev").iterdir()) == [
         "box.png", "capped_cylinder.png", "contact_sheet.png", "house.png", "l_prism.png"]

@@ -7,7 +7,7 @@ import pytest
 
 from curvenet.datasets import shapes
 from curvenet.cli import main
-from curvenet.model.patchset import save_network
+from curvenet.io.network import write_network
 from curvenet.pipeline import surface
 
 
@@ -15,7 +15,7 @@ def test_cad_format_without_the_extra_names_it(monkeypatch, tmp_path, capsys):
     monkeypatch.setitem(sys.modules, "OCP", None)          # import OCP -> ImportError
     monkeypatch.setitem(sys.modules, "rhino3dm", None)
     src = tmp_path / "box.json"
-    save_network(src, shapes.box().network)
+    write_network(src, shapes.box().network)
     for out in ("m.step", "m.3dm"):
         assert main(["surface", str(src), "-o", str(tmp_path / out), "--no-progress"]) == 2
         err = capsys.readouterr().err.strip().splitlines()
@@ -188,13 +188,13 @@ def test_3dm_round_trip(tmp_path, make):
 def test_cli_step_explain(tmp_path, capsys):
     pytest.importorskip("OCP")
     src = tmp_path / "box.json"
-    save_network(src, shapes.box().network)
+    write_network(src, shapes.box().network)
     assert main(["surface", str(src), "-o", str(tmp_path / "b.step"), "--explain",
                  "--no-progress"]) == 0
     out = capsys.readouterr().out
     assert "cad: 6 B-spline faces (6 exact" in out and "valid True" in out
     src2 = tmp_path / "sheet.json"
-    save_network(src2, shapes.grid_sheet().network)
+    write_network(src2, shapes.grid_sheet().network)
     rep = tmp_path / "r.json"
     assert main(["surface", str(src), str(src2), "--out-dir", str(tmp_path / "d"), "--format",
                  "step", "--report", str(rep), "--no-progress"]) == 0

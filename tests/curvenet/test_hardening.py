@@ -66,6 +66,16 @@ def test_output_through_a_link_to_the_input_is_refused(tmp_path, box_obj, capsys
     assert box_obj.read_bytes() == before
 
 
+@pytest.mark.parametrize("command", ["surface", "patches", "snap"])
+def test_a_symlink_loop_given_as_input_is_bad_input(tmp_path, capsys, command):
+    a, b = tmp_path / "a.obj", tmp_path / "b.obj"
+    a.symlink_to(b)
+    b.symlink_to(a)
+    assert main([command, str(a), "-o", str(tmp_path / "out.obj")]) == 2
+    one_error_line(capsys, "symbolic link that leads nowhere")
+    assert not (tmp_path / "out.obj").exists()
+
+
 def test_patches_of_another_sketch_are_refused(tmp_path, box_obj, capsys):
     cyl = tmp_path / "cyl.obj"
     write_sketch(cyl, shapes.capped_cylinder().sketch())

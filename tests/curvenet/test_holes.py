@@ -10,7 +10,8 @@ from curvenet.datasets import shapes
 from curvenet.cycles.find import find_patches
 from curvenet.cycles.holes import hole_patches
 from curvenet.cycles.loops import signed_volume
-from curvenet.model.patchset import Patch, PatchSet, load_network_file, save_patchset
+from curvenet.io.network import read_patches, write_patches
+from curvenet.model.patchset import Patch, PatchSet
 
 CAD = sorted(shapes.CAD_SHAPES)
 
@@ -146,8 +147,8 @@ def test_submarine_fin_base_stays_a_disc(data_dir):
 def test_patches_json_keeps_holes(tmp_path):
     s = shapes.washer()
     ps = find_patches(s.network)
-    save_patchset(tmp_path / "p.json", ps)
-    back = load_network_file(tmp_path / "p.json")
+    write_patches(tmp_path / "p.json", ps)
+    back = read_patches(tmp_path / "p.json")
     assert [(p.edges, p.holes) for p in back.patches] == [(p.edges, p.holes) for p in ps.patches]
     data = json.loads((tmp_path / "p.json").read_text())
     assert data["version"] == 1

@@ -7,7 +7,7 @@ import curvenet
 from curvenet.datasets import shapes
 from curvenet.cli import main
 from curvenet.core.fidelity import sketch_fidelity
-from curvenet.route.hybrid import plan_regions
+from curvenet.route.regions import plan_regions
 from curvenet.io.meshes import read_obj_wires
 from curvenet.model.sketch import Sketch
 
@@ -46,13 +46,13 @@ def _flower():
 def test_regions_split_surface_like_strokes_from_single_curves():
     curves = _ribbon() + [_leg()] + [np.c_[T + 3, 0 * T, 0 * T]]
     regions = plan_regions(curves, np.zeros(len(curves), bool))
-    routes = sorted((r["route"], tuple(r["curves"])) for r in regions)
+    routes = sorted((r.route, tuple(r.curves)) for r in regions)
     assert routes == [("neural", (0, 1, 2, 3, 4, 5)), ("wires", (6,)), ("wires", (7,))]
 
 
 def test_four_separate_legs_stay_wires():
     legs = [np.c_[0 * T + x, 0 * T + y, -T] for x in (0, 1) for y in (0, 1)]
-    assert [r["route"] for r in plan_regions(legs, np.zeros(4, bool))] == ["wires"] * 4
+    assert [r.route for r in plan_regions(legs, np.zeros(4, bool))] == ["wires"] * 4
 
 
 def test_fully_covered_sketch_is_todays_classical_output(tmp_path):
@@ -69,8 +69,8 @@ def test_fully_covered_sketch_is_todays_classical_output(tmp_path):
 def test_flower_patches_petals_and_leaves_and_keeps_the_stem_as_a_wire(tmp_path):
     res = curvenet.surface(_flower())
     assert res.method == "classical"
-    assert [r["route"] for r in res.decision.regions] == ["classical", "wires"]
-    assert res.decision.regions[0]["patches"] == 6
+    assert [r.route for r in res.decision.regions] == ["classical", "wires"]
+    assert res.decision.regions[0].patches == 6
     # the wires are the stem stroke's own points (x = y = 0) where no patch passes
     wires = np.concatenate(res.wires)
     np.testing.assert_allclose(wires[:, :2], 0.0, atol=1e-12)
@@ -109,7 +109,7 @@ def test_box_with_a_loose_ribbon_gets_a_neural_fill_and_a_wire(tmp_path):
     sketch = Sketch(sk.strokes + _ribbon() + [_leg()], list(sk.labels) + ["boundary"] * 7)
     res = curvenet.surface(sketch)
     assert res.method == "hybrid"
-    assert [r["route"] for r in res.decision.regions] == ["classical", "neural", "wires"]
+    assert [r.route for r in res.decision.regions] == ["classical", "neural", "wires"]
     assert res.routes == ("classical", "neural")
     counts = np.bincount(res.face_route)
     # the classical part is the classical route's surface of the same sketch (the output
@@ -130,15 +130,15 @@ def test_box_with_a_loose_ribbon_gets_a_neural_fill_and_a_wire(tmp_path):
 def test_a_small_surface_like_region_stays_wires():
     # beside a large patched part, a ribbon carrying under MIN_FILL_LENGTH of the curve
     # length is not worth a neural fit
-    from curvenet.route.hybrid import MIN_FILL_LENGTH, plan_regions
+    from curvenet.route.regions import MIN_FILL_LENGTH, plan_regions
     t = np.linspace(0, 1, 20)[:, None]
     ribbon = [np.hstack([t, 0 * t + y, 0 * t]) for y in np.linspace(0, 0.5, 11)]
     length = sum(float(np.linalg.norm(np.diff(c, axis=0), axis=1).sum()) for c in ribbon)
     n_big = int(np.ceil(length / MIN_FILL_LENGTH / 10.0)) + 1
     big = [np.hstack([10 * t + 5, 0 * t + k, 0 * t]) for k in range(n_big)]
     used = np.r_[np.zeros(len(ribbon), bool), np.ones(n_big, bool)]
-    assert [r["route"] for r in plan_regions(ribbon + big, used)] == ["wires"]
-    assert [r["route"] for r in plan_regions(ribbon, np.zeros(11, bool))] == ["neural"]
+    assert [r.route for r in plan_regions(ribbon + big, used)] == ["wires"]
+    assert [r.route for r in plan_regions(ribbon, np.zeros(11, bool))] == ["neural"]
 
 
 def _box_mesh():
@@ -148,7 +148,7 @@ def _box_mesh():
 
 def test_stroke_wires_are_the_strokes_own_stretches_off_the_surface():
     from curvenet.core.distance import point_surface_distance
-    from curvenet.route.hybrid import stroke_wires
+    from curvenet.route.wires import stroke_wires
     box = _box_mesh()
     # along the top edge of the cube, then a zigzag away from it
     leaving = np.array([[-0.5, -0.5, 0.5], [0.5, -0.5, 0.5], [0.8, -0.5, 0.7],
@@ -189,14 +189,14 @@ def test_an_overdrawn_stroke_the_surface_misses_is_kept_as_a_wire(tmp_path):
 def test_a_round_plate_of_strokes_is_surface_like():
     """An oval rim with strokes across it: most of its hull lies near a stroke, though the
     corners of its bounding rectangle (which an oval never reaches) do not."""
-    from curvenet.route.hybrid import FILL_SHARE, REGION_GAP
+    from curvenet.route.regions import FILL_SHARE, REGION_GAP
     u = np.linspace(0, 2 * np.pi, 200)
     rim = np.c_[np.cos(u), 0.8 * np.sin(u), 0 * u]
     chords = [np.c_[np.linspace(-1, 1, 30) * np.sqrt(1 - (y / 0.8) ** 2), 0 * T[:30] + y,
                     0 * T[:30]] for y in np.linspace(-0.457, 0.457, 4)]
     curves = [rim] + chords
     (region,) = plan_regions(curves, np.zeros(5, bool))
-    assert region["route"] == "neural" and region["fill"] >= FILL_SHARE
+    assert region.route == "neural" and region.fill >= FILL_SHARE
     # the bounding rectangle alone would have judged it a set of wires
     gap = REGION_GAP * np.linalg.norm(np.ptp(np.concatenate(curves), axis=0)) / 2
     g = np.stack(np.meshgrid(np.linspace(-1, 1, 16), np.linspace(-0.8, 0.8, 16)),
@@ -302,8 +302,8 @@ def test_a_fill_beside_patches_meets_them_along_the_shared_curve():
     res = curvenet.surface(sketch, neural_options=_SMALL_NEURAL)
     assert res.method == "hybrid"
     region = res.decision.regions[1]
-    assert region["route"] == "neural" and region["anchors"] > 0
-    assert 0 < region["seam_moved"] <= 0.08 / 4        # moves stay within gap / 4
+    assert region.route == "neural" and region.anchors > 0
+    assert 0 < region.seam_moved <= 0.08 / 4        # moves stay within gap / 4
     tol = 0.01 * res.diagnostics["fidelity"]["diagonal"]
     faces = res.mesh.faces[res.face_route == 1]
     centres = res.mesh.vertices[faces].mean(axis=1)
@@ -313,5 +313,5 @@ def test_a_fill_beside_patches_meets_them_along_the_shared_curve():
     edge = np.c_[0 * T + 1.0, 0.15 + 0.7 * T, 0 * T + 1.0]
     seam = fill_seam(res.mesh.vertices, faces, [edge], gap=0.08, tol=tol)
     assert seam["seam"] >= 0.9 and seam["seam_p95"] < 2 * tol
-    assert region["seam"] >= 0.6 and region["seam"] >= region["seam_fit"]
-    assert f"meets the patches along {region['seam']:.0%}" in res.decision.explain_regions()[1]
+    assert region.seam >= 0.6 and region.seam >= region.seam_fit
+    assert f"meets the patches along {region.seam:.0%}" in res.decision.explain_regions()[1]

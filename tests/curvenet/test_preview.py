@@ -178,7 +178,7 @@ def test_import_is_light():
 
 
 def test_faces_coloured_by_route_and_wires_drawn(tmp_path):
-    from curvenet.view.preview import ROUTE_COLOURS, WIRE_COLOUR
+    from curvenet.view import ROUTE_COLOURS, WIRE_COLOUR
     a = trimesh.creation.icosphere(subdivisions=3)
     b = a.copy()
     b.vertices += [3.0, 0.0, 0.0]

@@ -14,7 +14,8 @@ from curvenet.datasets import shapes
 from curvenet.cycles.gf2 import edge_mask, gf2_rank
 from curvenet.cycles.find import find_patches
 from curvenet.core.errors import InvalidParameterError, NetworkError
-from curvenet.model.patchset import PatchSet, load_network_file
+from curvenet.io.network import read_patches
+from curvenet.model.patchset import PatchSet
 from curvenet.cycles.session import PatchSession, Suggestion
 from curvenet.review import run_interactive
 
@@ -143,7 +144,7 @@ def test_save_roundtrip(tmp_path, box):
     session.accept(session.closing_suggestions()[0])
     path = tmp_path / "p.json"
     session.save(path)
-    back = load_network_file(path)
+    back = read_patches(path)
     assert edge_sets(back.patches) == true_faces(box)
     assert [p.source for p in back.patches].count("closing") == 1
 
@@ -174,7 +175,7 @@ def test_interactive_delete_reject_then_accept_and_save(tmp_path, two_boxes):
     assert "rejected" in text and "accepted" in text and "undone" in text
     # two undos: back to the start (accept and reject undone, the delete kept)
     assert len(ps.patches) == len(ps0.patches) - 1
-    assert load_network_file(path).patches == ps.patches
+    assert read_patches(path).patches == ps.patches
 
 
 def test_interactive_end_of_input_and_bad_commands(box):

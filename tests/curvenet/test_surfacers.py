@@ -56,10 +56,11 @@ def box_obj(tmp_path):
 
 
 def test_builtins_are_registered_without_importing_backends():
-    assert surfacer_names() == ("catmull-clark", "soapfilm", "neural")
+    assert surfacer_names() == ("catmull-clark", "soapfilm", "neural", "hybrid")
     assert surfacer_names("patches") == ("catmull-clark", "soapfilm")
+    assert surfacer_names("regions") == ("hybrid",)
     assert get_surfacer("catmull-clark").label == "classical"
-    code = ("import sys, curvenet.route.registry, curvenet.cli; curvenet.cli.build_parser(); "
+    code = ("import sys, curvenet.route, curvenet.cli; curvenet.cli.build_parser(); "
             "bad = [m for m in ('torch', 'curvenet.surfacing', 'curvenet.neural') "
             "if m in sys.modules]; sys.exit(str(bad) if bad else 0)")
     r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
@@ -87,7 +88,7 @@ def test_a_toy_patch_surfacer_gets_oriented_loops(toys):
     assert abs(res.mesh.volume) == pytest.approx(1.0, abs=1e-9)
     # the same toy also serves as the classical route's surfacer
     res2 = curvenet.surface(shapes.box().sketch(), surfacer="fan")
-    assert res2.method == "fan" and res2.decision.method == "classical"
+    assert res2.method == "fan" and res2.decision.route == "classical"
     assert res2.decision.reason == "covered"
 
 
@@ -174,7 +175,7 @@ def test_route_decision_is_data():
     from curvenet.route.decision import auto_route
     res = curvenet.surface(shapes.box().sketch())
     d = res.decision
-    assert (d.method, d.surfacer, d.reason, d.patches) == ("classical", "catmull-clark",
+    assert (d.route, d.surfacer, d.reason, d.patches) == ("classical", "catmull-clark",
                                                            "covered", 6)
     assert json.loads(json.dumps(asdict(d)))["coverage"] == pytest.approx(1.0)
     # the sentences are those --explain has always printed
