@@ -13,13 +13,10 @@ Engineering choices (documented deviations / gap fills)
 ------------------------------------------------------
 * Derivatives of g come from a closed-form second-order jet of the SIREN
   (:meth:`neural.siren.GradientSiren.jet`), not nested autograd; the covariant
-  derivative of II is the chain rule through Eq. 14-15 on that jet
-  (``smooth_mode="autograd"`` uses double backward instead).
-* Surface samples (Sec. 5.2 "marching cubes") are drawn, by default, on the
+  derivative of II is the chain rule through Eq. 14-15 on that jet.
+* Surface samples (Sec. 5.2 samples the marching-cubes mesh) are drawn on the
   device: random points in the grid cells where f changes sign, projected on the
-  zero level of the trilinear interpolant by two Newton steps
-  (``surface_sampler="cells"``); ``"marching_cubes"`` samples the scikit-image
-  mesh by area on the host as the paper does.
+  zero level of the trilinear interpolant by two Newton steps.
 * ``poisson_every = k > 1`` solves the Poisson equation every k steps; between
   solves the data term is replaced by its linearisation
   ``<lambda, splat(g)>`` with ``lambda`` the gradient of the weighted data loss
@@ -30,11 +27,6 @@ Engineering choices (documented deviations / gap fills)
   ``normalize_from`` of the full stage on: each node's sum is divided by
   ``max(weight sum, mean positive weight sum)``, which removes the density bias
   of the stroke samples without inflating sparsely hit nodes.
-* ``stroke_strip > 0`` (off in every preset): the surface samples within that
-  many cells of a stroke sample are left out of the splat and the stroke
-  samples carry their mass (:func:`neural.poisson.stroke_strip`),
-  so the splat has one density along the surface; the paper splats the stroke
-  samples on top of the surface ones.
 * ``geometric_init_steps > 0`` (draft, default) first fits g to the gradient
   ``sigma (x - c) / |x - c|`` of a sphere around the stroke centroid c (cheap:
   no derivatives), a geometric initialisation like the published code's
@@ -62,8 +54,8 @@ Engineering choices (documented deviations / gap fills)
   terms tried against it, are in ``benchmarks/README.md``).
 * ``polish = k > 0`` re-integrates the final f (forward passes only) from k times
   the stroke and surface samples of one step, ``polish_rounds`` times, optionally
-  with the stroke strip (``polish_strip``) and a low-pass: less Monte-Carlo noise in
-  the splat and, with the strip, no shrinking between smooth strokes. With
+  with the stroke strip (``polish_strip``): less Monte-Carlo noise in the splat and,
+  with the strip, no shrinking between smooth strokes. With
   ``average_from < 1`` its g is the running mean of the network's parameters over the
   full stage from that fraction on (stochastic weight averaging), which has less of
   the last steps' noise than the last step's network, and it starts from the running
@@ -103,8 +95,7 @@ from curvenet.core.tolerances import COINCIDENT_REL, NORM_EPS, TINY_F32
 from .presets import FlowConfig, get_config
 from .training import Stage, Step, seeded, torch_device, train
 
-__all__ = ["FlowResult", "fit_flow_surface", "StrokeSampler", "sample_surface_cells",
-           "sample_surface_marching_cubes", "Frame"]
+__all__ = ["FlowResult", "fit_flow_surface", "StrokeSampler", "sample_surface_cells", "Frame"]
 
 _TERMS = ("total", "align", "smooth", "data", "eik", "curl", "normal")
 
@@ -248,19 +239,6 @@ def sample_surface_cells(f_grid, n: int, gen, *, newton_steps: int = 2):
     return p.clamp(0.0, 1.0)
 
 
-def sample_surface_marching_cubes(f_grid, n: int, rng: np.random.Generator):
-    """Area-uniform samples on the scikit-image marching-cubes mesh of f (host).
-
-    Returns ``(n, 3)`` unit-cube points as a numpy array, or None.
-    """
-    from .extract import marching_cubes_world
-    res = f_grid.shape[0]
-    V, Fc = marching_cubes_world(f_grid.detach().cpu().numpy(), np.full(3, 0.5 / res), 1.0 / res)
-    if len(Fc) == 0:
-        return None
-    return _sample_triangles(V, Fc, n, rng)
-
-
 def _sample_triangles(V, F, n, rng):
     """``n`` area-uniform points ``(n, 3)`` on the mesh ``(V, F)``, or None if all degenerate."""
     areas = face_normals_areas(V, F)[1]
@@ -399,8 +377,7 @@ class _FlowFit:
         self.net = GradientSiren(cfg.width, cfg.hidden_layers, cfg.omega_0).to(
             device=dev, dtype=self.dtype)
         self.sampler = StrokeSampler(strokes_unit, dev, self.dtype)
-        self.solver = PoissonSolver(cfg.res, device=dev, dtype=self.dtype,
-                                    smooth_cells=cfg.smooth_cells, boundary=cfg.boundary)
+        self.solver = PoissonSolver(cfg.res, device=dev, dtype=self.dtype, boundary=cfg.boundary)
         self.f = None                  # the last solved f (unit-cube grid)
         self.lam = None                # d(data loss) / d(splat), for poisson_every > 1
         self.data = float("nan")       # the last solved data loss
@@ -445,13 +422,12 @@ class _FlowFit:
             full = Stage("full", cfg.steps, self._flow_step("full", cfg.steps))
         return [first, full]
 
-    def solve(self, points, values, normalize, need_adjoint, n_stroke=None, mass=None,
-              solver=None):
+    def solve(self, points, values, normalize, need_adjoint, n_stroke=None, mass=None):
         """Splat -> FFT Poisson -> Eq. 11; returns (f_grid, data loss, raw grid).
 
         The first ``n_stroke`` (default ``cfg.n_stroke``) points are the data samples
         (the stroke samples, then the anchors'); ``mass`` (optional, (M,)) weighs the
-        points in the splat; ``solver`` (default the fit's) solves.
+        points in the splat.
         """
         from .losses import data_loss
         from .poisson import interpolate, normalize_scale_shift, normalize_splat, splat
@@ -461,7 +437,7 @@ class _FlowFit:
             raw.retain_grad()
         if normalize:
             grid = normalize_splat(grid, wsum)
-        f = (solver or self.solver).solve(grid)
+        f = self.solver.solve(grid)
         f_s = interpolate(f, points[: n_stroke or self.cfg.n_stroke])
         f, f_s = normalize_scale_shift(f, f_s)
         return f, data_loss(f_s), raw
@@ -472,22 +448,16 @@ class _FlowFit:
         Each round draws ``cfg.polish`` times the stroke and surface samples of a step
         (the surface ones on the zero set of the round before), in the same proportion,
         and splats them with the normalisation of the last step, leaving out the surface
-        samples within ``cfg.polish_strip`` cells of the strokes; the solve low-passes by
-        ``cfg.polish_smooth_cells``. The Monte-Carlo noise of the splat is down by about
-        ``sqrt(cfg.polish)``; the per-node normalisation sees ``cfg.polish`` times the
-        weight, so even one round without strip or low-pass is not quite a step's
-        field (``benchmarks/README.md``). g is the averaged network (:meth:`_average`)
+        samples within ``cfg.polish_strip`` cells of the strokes. The Monte-Carlo noise of
+        the splat is down by about ``sqrt(cfg.polish)``; the per-node normalisation sees
+        ``cfg.polish`` times the weight, so even one round without strip is not quite a
+        step's field. g is the averaged network (:meth:`_average`)
         if there is one, else the last step's; the first round's surface samples lie on
         the zero set of the averaged f if there is one, else of ``f``.
         """
         import torch
-
-        from .poisson import PoissonSolver
         cfg = self.cfg
         normalize = cfg.steps - 1 >= int(cfg.normalize_from * cfg.steps)   # as the last step
-        solver = self.solver if cfg.polish_smooth_cells == cfg.smooth_cells else PoissonSolver(
-            cfg.res, device=self.dev, dtype=self.dtype, smooth_cells=cfg.polish_smooth_cells,
-            boundary=cfg.boundary)
         net = self.net if self.averaged is None else self.averaged.module
         f = f if self.f_mean is None else self.f_mean
         with torch.no_grad():
@@ -499,8 +469,7 @@ class _FlowFit:
                     x_u = x_u[keep]
                 pts = x_s if x_u is None else torch.cat([x_s, x_u])
                 vals = torch.cat([net(p) for p in pts.split(65536)])
-                f = self.solve(pts, vals, normalize, False, n_stroke=len(x_s), mass=mass,
-                               solver=solver)[0]
+                f = self.solve(pts, vals, normalize, False, n_stroke=len(x_s), mass=mass)[0]
         return f
 
     def _average(self):
@@ -568,13 +537,8 @@ class _FlowFit:
         return self.f
 
     def _surface_samples(self, n):
-        import torch
-        if self.f is None:
-            return None
-        if self.cfg.surface_sampler == "cells":
-            return sample_surface_cells(self.f, n, self.gen)
-        p = sample_surface_marching_cubes(self.f, n, self.rng)
-        return None if p is None else torch.as_tensor(p, device=self.dev, dtype=self.dtype)
+        """``n`` samples on the zero set of the last solved f, or None before the first."""
+        return None if self.f is None else sample_surface_cells(self.f, n, self.gen)
 
     def _prefit_step(self, k):
         import torch
@@ -599,23 +563,19 @@ class _FlowFit:
             g_sv, G_sv = net.jet(torch.cat([x_s, x_v]), order=1)
             g_s, G_s = g_sv[: cfg.n_stroke], G_sv[: cfg.n_stroke]
             x_u = self._surface_samples(cfg.n_surface) if full else None
-            vals = {"align": alignment_loss(g_s, G_s, t_s, cfg.align_penalty),
+            vals = {"align": alignment_loss(g_s, G_s, t_s),
                     "curl": curl_loss(G_sv[cfg.n_stroke:])}
             x_s, g_s = self._anchor_terms(vals, x_s, g_s)
-            pts, gv, mass = self._surface_terms(vals, x_u, x_s, g_s)
-            if cfg.splat_volume:
-                pts, gv = torch.cat([pts, x_v]), torch.cat([gv, g_sv[cfg.n_stroke:]])
-                if mass is not None:
-                    mass = torch.cat([mass, mass.new_ones(len(x_v))])
+            pts, gv = self._surface_terms(vals, x_u, x_s, g_s)
             normalize = full and k >= int(cfg.normalize_from * n_steps)
             average = full and cfg.polish > 0 and k >= int(cfg.average_from * n_steps)
             do_solve = (k % cfg.poisson_every == 0) or k == n_steps - 1 or self.lam is None
             if do_solve:
                 f, vals["data"], raw = self.solve(pts, gv, normalize, cfg.poisson_every > 1,
-                                                  n_stroke=len(x_s), mass=mass)
+                                                  n_stroke=len(x_s))
                 data_term = cfg.w_data * vals["data"]
             else:
-                data_term = (self.lam * splat(pts, gv, cfg.res, mass)[0]).sum()
+                data_term = (self.lam * splat(pts, gv, cfg.res)[0]).sum()
             loss = (cfg.w_align * vals["align"] + cfg.w_curl * vals["curl"]
                     + cfg.w_eik * vals["eik"] + data_term)
             for term, w in (("smooth", cfg.w_smooth), ("normal", cfg.w_normal)):
@@ -645,33 +605,28 @@ class _FlowFit:
 
     def _strip(self, x_s, x_u, cells):
         """``(keep, mass)`` of :func:`neural.poisson.stroke_strip` (``cells`` wide);
-        ``(None, None)``, all splatted with mass 1, without x_u or strip."""
+        ``(None, None)``, all splatted with mass 1, without x_u or strip (the polish)."""
         if x_u is None or cells <= 0:
             return None, None
         from .poisson import stroke_strip
         return stroke_strip(x_s, x_u, cells / self.cfg.res)
 
     def _surface_terms(self, vals, x_u, x_s, g_s):
-        """Smoothness and Eikonal terms into ``vals``; the points, g and masses to splat."""
+        """Smoothness and Eikonal terms into ``vals``; the points and g to splat."""
         import torch
 
-        from .losses import eikonal_loss, smoothness_loss, smoothness_loss_autograd
+        from .losses import eikonal_loss, smoothness_loss
         cfg, net = self.cfg, self.net
         if x_u is None:
             vals["eik"] = eikonal_loss(g_s, cfg.sigma)
-            return x_s, g_s, None
-        if cfg.w_smooth > 0 and cfg.smooth_mode == "jet":
+            return x_s, g_s
+        if cfg.w_smooth > 0:
             g_u, G_u, H_u = net.jet(x_u, order=2)
             vals["smooth"] = smoothness_loss(g_u, G_u, H_u)
         else:
             g_u = net(x_u)
-            if cfg.w_smooth > 0:
-                vals["smooth"] = smoothness_loss_autograd(net, x_u)
         vals["eik"] = eikonal_loss(torch.cat([g_u, g_s]), cfg.sigma)
-        keep, mass = self._strip(x_s, x_u, cfg.stroke_strip)
-        if keep is not None:
-            x_u, g_u = x_u[keep], g_u[keep]
-        return torch.cat([x_s, x_u]), torch.cat([g_s, g_u]), mass
+        return torch.cat([x_s, x_u]), torch.cat([g_s, g_u])
 
     def _row(self, vals) -> list:
         """The loss terms of :data:`_TERMS` as floats (NaN where not computed)."""

@@ -123,9 +123,6 @@ class FlowConfig:
         Adam learning rate. grad_clip : float, gradient-norm clip (0 = off).
     w_align, w_smooth, w_data, w_eik, w_curl : float
         Loss weights of Eq. 13 (paper: 1, 0.01, 30, 7, 7).
-    align_penalty : str
-        ``"square"`` (Eq. 4: ``(cos 4 alpha - 1)^2``) or ``"abs"`` (``|cos 4 alpha - 1|``,
-        the published code's) for the alignment term.
     w_normal : float
         Weight of the anchors' normal term (:func:`neural.losses.normal_loss`; only
         with ``anchors``, not in the paper).
@@ -136,27 +133,12 @@ class FlowConfig:
     normalize_from : float
         Fraction of the full stage after which the rasterised g is normalised
         per grid point (Sec. 5.1, "once the optimization has stabilized").
-    smooth_cells : float
-        Gaussian low-pass of the Poisson solution, standard deviation in grid
-        cells (0 = the exact Eq. 10).
-    surface_sampler : str
-        ``"cells"`` (zero-crossing cells + Newton projection, on the device) or
-        ``"marching_cubes"`` (scikit-image, on the host).
-    smooth_mode : str
-        ``"jet"`` (closed-form third derivatives of the SIREN) or ``"autograd"``
-        (double backward) for the covariant derivative of II (Eq. 18).
     prefit_steps : int
         Steps fitting g to sigma * grad SDF of ``init_mesh`` (refinement only).
     geometric_init_steps : int
         Steps fitting g to the gradient of a sphere around the strokes before
         the initialisation stage (0 = plain SIREN initialisation, as the paper
         text; the published code uses a sphere initialisation).
-    splat_volume : bool
-        Also splat g at the volume samples into the Poisson right-hand side, so
-        that f follows g away from the surface too (the paper splats stroke and
-        surface samples only, Sec. 5.1). Off by default: it does not keep a zero
-        set from closing through the periodic box, because the smoothness term
-        itself prefers that surface.
     dtype : str
         ``"float32"`` or ``"float64"``.
     polish : int
@@ -169,22 +151,16 @@ class FlowConfig:
         gives both figures. Not in the paper (see the notes above).
     polish_rounds : int
         Rounds of the polish (at least 1).
-    polish_smooth_cells : float
-        Gaussian low-pass of the polish's solves, standard deviation in grid cells
-        (the published code low-passes every solve by about one cell).
     polish_strip : float
-        ``stroke_strip`` of the polish's splats (cells; 0 = none).
+        Surface samples closer than this many grid cells to a stroke sample are left
+        out of the polish's splats and the stroke samples carry their mass
+        (:func:`neural.poisson.stroke_strip`); 0 splats every sample with mass 1.
     average_from : float
         Fraction of the full stage from which the network's parameters and the
         solved f are averaged (running means; stochastic weight averaging of the
         parameters) for the polish, which then integrates the averaged network's g
         from the averaged f's zero set; 1 = no averaging (the last step's
         network and f). Training itself is unchanged.
-    stroke_strip : float
-        Surface samples closer than this many grid cells to a stroke sample are
-        left out of the full stage's splat and the stroke samples carry their mass
-        (:func:`neural.poisson.stroke_strip`);
-        0 splats every sample with mass 1, as the paper and the published code do.
     """
 
     res: int = 128
@@ -206,23 +182,16 @@ class FlowConfig:
     w_eik: float = 7.0
     w_curl: float = 7.0
     w_normal: float = 7.0
-    align_penalty: str = "square"
     sigma: float = 0.5
     poisson_every: int = 1
     normalize_from: float = 0.6
-    smooth_cells: float = 0.0
-    surface_sampler: str = "cells"
-    smooth_mode: str = "jet"
     prefit_steps: int = 150
     geometric_init_steps: int = 100
-    splat_volume: bool = False
     dtype: str = "float32"
     polish: int = 0
     polish_rounds: int = 1
-    polish_smooth_cells: float = 0.0
     polish_strip: float = 0.0
     average_from: float = 1.0
-    stroke_strip: float = 0.0
 
     def as_dict(self) -> dict:
         """The settings as a plain dict (for reports)."""
@@ -240,9 +209,7 @@ PRESETS: dict[str, FlowConfig] = {
                         geometric_init_steps=0),
 }
 
-_CHOICES = {"align_penalty": ("square", "abs"), "boundary": ("periodic", "dirichlet"),
-            "surface_sampler": ("cells", "marching_cubes"), "smooth_mode": ("jet", "autograd"),
-            "dtype": ("float32", "float64")}
+_CHOICES = {"boundary": ("periodic", "dirichlet"), "dtype": ("float32", "float64")}
 
 
 def _from_preset(presets: dict, quality: str, overrides: dict, what: str):
@@ -301,7 +268,7 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
         if not getattr(cfg, name) > 0:
             raise ValueError(f"{name} must be positive, got {getattr(cfg, name)!r}")
     for name in ("w_align", "w_smooth", "w_data", "w_eik", "w_curl", "w_normal", "grad_clip",
-                 "smooth_cells", "polish_smooth_cells", "stroke_strip", "polish_strip"):
+                 "polish_strip"):
         if not getattr(cfg, name) >= 0:
             raise ValueError(f"{name} must be non-negative, got {getattr(cfg, name)!r}")
     for name in ("normalize_from", "average_from"):
@@ -333,8 +300,8 @@ def parse_setting(text: str) -> tuple[str, object]:
     --------
     >>> parse_setting("w_smooth=0.01")
     ('w_smooth', 0.01)
-    >>> parse_setting("splat_volume=yes")
-    ('splat_volume', True)
+    >>> parse_setting("boundary=dirichlet")
+    ('boundary', 'dirichlet')
     """
     name, sep, raw = text.partition("=")
     name, raw = name.strip(), raw.strip()
@@ -344,11 +311,6 @@ def parse_setting(text: str) -> tuple[str, object]:
     if name not in kinds:
         raise ValueError(f"unknown neural setting {name!r}; valid: {sorted(kinds)}")
     kind = kinds[name]
-    if kind is bool:
-        truth = {"true": True, "yes": True, "1": True, "false": False, "no": False, "0": False}
-        if raw.lower() not in truth:
-            raise ValueError(f"{name} takes true or false, got {raw!r}")
-        return name, truth[raw.lower()]
     try:
         return name, kind(raw)
     except ValueError:

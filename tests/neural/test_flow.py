@@ -68,9 +68,8 @@ def test_keyboard_interrupt_returns_surface_so_far(monkeypatch):
     assert r.f_grid.shape == (32, 32, 32)
 
 
-def test_poisson_every_and_marching_cubes_sampler_run():
-    r = fit_flow_surface(_circles(), progress=False, poisson_every=2,
-                         surface_sampler="marching_cubes", **TINY)
+def test_poisson_every_runs():
+    r = fit_flow_surface(_circles(), progress=False, poisson_every=2, **TINY)
     assert len(r.history["full"]["total"]) == 4
     assert np.isfinite(r.history["full"]["total"]).all()
 
@@ -98,13 +97,12 @@ def test_refine_prefit_reproduces_the_init_mesh():
 
 def test_polish_keeps_the_surface_of_the_field():
     # g prefitted to sigma * grad SDF of the unit sphere, no flow step: f re-integrated from
-    # 16 times the samples of a step (strokes and f's zero set), low-passed by one cell, must
-    # still be that sphere, the one the stroke circles lie on
+    # 16 times the samples of a step (strokes and f's zero set) must still be that sphere,
+    # the one the stroke circles lie on
     import trimesh
     m = trimesh.creation.icosphere(3, radius=1.0)
     r = fit_flow_surface(_circles(), progress=False, init_mesh=(m.vertices, m.faces),
-                         quality="draft", res=48, prefit_steps=150, steps=0, polish=16,
-                         polish_smooth_cells=1.0)
+                         quality="draft", res=48, prefit_steps=150, steps=0, polish=16)
     radius = np.linalg.norm(r.vertices, axis=1)
     assert abs(radius.mean() - 1.0) < 0.02 and radius.std() < 0.01, (radius.mean(), radius.std())
 
@@ -149,7 +147,7 @@ def _averaged_sphere_fit():
     from curvenet.neural.presets import get_config
     from curvenet.neural.training import train
     m = trimesh.creation.icosphere(3, radius=1.0)
-    cfg = get_config("draft", res=48, prefit_steps=150, polish=16, polish_smooth_cells=1.0)
+    cfg = get_config("draft", res=48, prefit_steps=150, polish=16)
     fit = flow._FlowFit(_circles(), cfg, torch.device("cpu"), 0, (m.vertices, m.faces))
     train(fit.net.parameters(), fit.stages()[:1], lr=cfg.lr)
     fit.f = _sphere_f(fit.frame, 48, 1.0)
@@ -348,13 +346,13 @@ def test_stroke_strip_keeps_a_sphere_between_its_strokes():
     assert abs(_integrate_radial_field(strip=True)) < 0.06
 
 
-def test_stroke_strip_in_the_fit_keeps_the_sphere():
+def test_polish_with_the_stroke_strip_keeps_the_sphere():
     # g prefitted to the unit sphere, two normalised flow steps and the polish with the strip:
     # the surface stays the sphere the stroke circles lie on
     import trimesh
     m = trimesh.creation.icosphere(3, radius=1.0)
     r = fit_flow_surface(_circles(), progress=False, init_mesh=(m.vertices, m.faces),
                          quality="draft", res=48, prefit_steps=150, steps=2, normalize_from=0.0,
-                         stroke_strip=1.0, polish=8, polish_strip=1.0)
+                         polish=8, polish_strip=1.0)
     radius = np.linalg.norm(r.vertices, axis=1)
     assert abs(radius.mean() - 1.0) < 0.02 and radius.std() < 0.015, (radius.mean(), radius.std())
