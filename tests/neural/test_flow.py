@@ -8,9 +8,13 @@ marked ``slow`` (the CI keeps the tiny end-to-end runs).
 import numpy as np
 import pytest
 
-from curvenet.neural import flow
+from curvenet.neural import flow, flowfit
 from curvenet.neural.flow import fit_flow_surface
+from curvenet.neural.flowfit import FlowFit
+from curvenet.neural.frame import Frame
 from curvenet.neural.poisson import stroke_strip
+from curvenet.neural.presets import get_config
+from curvenet.neural.sampling import StrokeSampler, sample_surface_cells
 
 from ._metrics import fscore
 
@@ -53,7 +57,7 @@ def test_deterministic_on_cpu():
 
 def test_keyboard_interrupt_returns_surface_so_far(monkeypatch):
     calls = {"n": 0}
-    real = flow.sample_surface_cells
+    real = flowfit.sample_surface_cells
 
     def interrupting(*args, **kwargs):
         calls["n"] += 1
@@ -61,7 +65,7 @@ def test_keyboard_interrupt_returns_surface_so_far(monkeypatch):
             raise KeyboardInterrupt
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(flow, "sample_surface_cells", interrupting)
+    monkeypatch.setattr(flowfit, "sample_surface_cells", interrupting)
     r = fit_flow_surface(_circles(), progress=False, **TINY)
     assert r.report["interrupted"] is True
     assert r.report["steps"]["full"] == 2
@@ -110,11 +114,11 @@ def test_polish_keeps_the_surface_of_the_field():
 def test_average_from_averages_the_last_steps_and_leaves_training_alone():
     # the running mean starts at step int(average_from * steps) of the full stage; the
     # steps themselves (losses, f) are those of a fit without it
-    from curvenet.neural.training import train
+    from curvenet.neural.training import torch_device, train
     runs, fields = {}, []
     for average_from in (0.5, 1.0):
-        cfg = flow.get_config("draft", **TINY, polish=2, average_from=average_from)
-        fit = flow._FlowFit(_circles(), cfg, flow.torch_device("cpu"), 0, None)
+        cfg = get_config("draft", **TINY, polish=2, average_from=average_from)
+        fit = FlowFit(_circles(), cfg, torch_device("cpu"), 0, None)
         record = fit._record
 
         def keep_f(stage, k, row, fit=fit, record=record):
@@ -144,11 +148,10 @@ def _averaged_sphere_fit():
     import torch
     import trimesh
 
-    from curvenet.neural.presets import get_config
     from curvenet.neural.training import train
     m = trimesh.creation.icosphere(3, radius=1.0)
     cfg = get_config("draft", res=48, prefit_steps=150, polish=16)
-    fit = flow._FlowFit(_circles(), cfg, torch.device("cpu"), 0, (m.vertices, m.faces))
+    fit = FlowFit(_circles(), cfg, torch.device("cpu"), 0, (m.vertices, m.faces))
     train(fit.net.parameters(), fit.stages()[:1], lr=cfg.lr)
     fit.f = _sphere_f(fit.frame, 48, 1.0)
     fit._average()
@@ -196,7 +199,7 @@ def test_polish_is_kept_only_when_it_holds_the_strokes(last, polished, kept):
     # radius 0.8 is off them and the last step's surface is returned; the other way round
     # (and on a tie) the polished one
     class Fit:
-        frame = flow.Frame.from_points(np.vstack(_circles()), 0.2)
+        frame = Frame.from_points(np.vstack(_circles()), 0.2)
 
         def polish(self, f):
             return _sphere_f(self.frame, 48, polished)
@@ -319,13 +322,13 @@ def _integrate_radial_field(strip, res=64, iters=12, n=1500, seed=0):
     R, c = 0.3, 0.5
     strokes = [c + R * s for s in _circles(200)]
     gen = torch.Generator().manual_seed(seed)
-    sampler = flow.StrokeSampler(strokes, "cpu", torch.float64)
+    sampler = StrokeSampler(strokes, "cpu", torch.float64)
     solver = PoissonSolver(res, dtype=torch.float64)
     x = (torch.arange(res, dtype=torch.float64) + 0.5) / res
     f = (torch.stack(torch.meshgrid(x, x, x, indexing="ij"), -1) - c).norm(dim=-1) - R
     for _ in range(iters):
         x_s, _ = sampler.sample(n, gen)
-        x_u = flow.sample_surface_cells(f, n, gen)
+        x_u = sample_surface_cells(f, n, gen)
         mass = None
         if strip:
             keep, mass = stroke_strip(x_s, x_u, 1.0 / res)
@@ -335,7 +338,7 @@ def _integrate_radial_field(strip, res=64, iters=12, n=1500, seed=0):
         f = solver.solve(grid)
         f, _ = normalize_scale_shift(f, interpolate(f, x_s))
         f = f if f[0, 0, 0] > 0 else -f
-    s = flow.sample_surface_cells(f, 20000, gen)
+    s = sample_surface_cells(f, 20000, gen)
     return float(((s - c).norm(dim=-1) - R).mean()) * res
 
 
