@@ -50,8 +50,8 @@ Engineering choices (documented deviations / gap fills)
   crease like 1 / (rounding width), so where strokes bound a region without
   strokes it prefers tangent-continuous surfaces: its minimiser for that
   cylinder is a capsule, and box faces bulge into pillows
-  (``benchmarks/bench_flow_limits.py`` measures both; the figures, and the
-  terms tried against it, are in ``benchmarks/README.md``).
+  (``benchmarks/bench_flow_limits.py`` measures both; the figures are in
+  ``benchmarks/README.md``).
 * ``polish = k > 0`` re-integrates the final f (forward passes only) from k times
   the stroke and surface samples of one step, ``polish_rounds`` times, optionally
   with the stroke strip (``polish_strip``): less Monte-Carlo noise in the splat and,
