@@ -175,7 +175,8 @@ class _Oracle:
 
         from curvenet.datasets.redraw import rough_sketch
         from curvenet.datasets.shapes import SHAPES
-        from curvenet.neural.flow import Frame, StrokeSampler
+        from curvenet.neural.frame import Frame
+        from curvenet.neural.sampling import StrokeSampler
         from curvenet.neural.poisson import PoissonSolver
 
         self.shape = SHAPES[name]()

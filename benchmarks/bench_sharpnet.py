@@ -54,7 +54,7 @@ RESULTS = Path(__file__).parent / "results"
 
 # ------------------------------------------------------------------------------ feature cost
 def _box_strips(n_tri: int = 2000, width: float = 0.05):
-    from curvenet.neural.creases import strip_from_polyline
+    from curvenet.neural.strips import strip_from_polyline
 
     corners = np.array([[x, y, z] for x in (0, 1) for y in (0, 1) for z in (0, 1)], float)
     edges = [(a, b) for a in range(8) for b in range(a + 1, 8)

@@ -13,13 +13,10 @@ Engineering choices (documented deviations / gap fills)
 ------------------------------------------------------
 * Derivatives of g come from a closed-form second-order jet of the SIREN
   (:meth:`neural.siren.GradientSiren.jet`), not nested autograd; the covariant
-  derivative of II is the chain rule through Eq. 14-15 on that jet
-  (``smooth_mode="autograd"`` uses double backward instead).
-* Surface samples (Sec. 5.2 "marching cubes") are drawn, by default, on the
+  derivative of II is the chain rule through Eq. 14-15 on that jet.
+* Surface samples (Sec. 5.2 samples the marching-cubes mesh) are drawn on the
   device: random points in the grid cells where f changes sign, projected on the
-  zero level of the trilinear interpolant by two Newton steps
-  (``surface_sampler="cells"``); ``"marching_cubes"`` samples the scikit-image
-  mesh by area on the host as the paper does.
+  zero level of the trilinear interpolant by two Newton steps.
 * ``poisson_every = k > 1`` solves the Poisson equation every k steps; between
   solves the data term is replaced by its linearisation
   ``<lambda, splat(g)>`` with ``lambda`` the gradient of the weighted data loss
@@ -30,11 +27,6 @@ Engineering choices (documented deviations / gap fills)
   ``normalize_from`` of the full stage on: each node's sum is divided by
   ``max(weight sum, mean positive weight sum)``, which removes the density bias
   of the stroke samples without inflating sparsely hit nodes.
-* ``stroke_strip > 0`` (off in every preset): the surface samples within that
-  many cells of a stroke sample are left out of the splat and the stroke
-  samples carry their mass (:func:`neural.poisson.stroke_strip`),
-  so the splat has one density along the surface; the paper splats the stroke
-  samples on top of the surface ones.
 * ``geometric_init_steps > 0`` (draft, default) first fits g to the gradient
   ``sigma (x - c) / |x - c|`` of a sphere around the stroke centroid c (cheap:
   no derivatives), a geometric initialisation like the published code's
@@ -58,12 +50,12 @@ Engineering choices (documented deviations / gap fills)
   crease like 1 / (rounding width), so where strokes bound a region without
   strokes it prefers tangent-continuous surfaces: its minimiser for that
   cylinder is a capsule, and box faces bulge into pillows
-  (``benchmarks/bench_flow_limits.py`` measures both; the figures, and the
-  terms tried against it, are in ``benchmarks/README.md``).
+  (``benchmarks/bench_flow_limits.py`` measures both; the figures are in
+  ``benchmarks/README.md``).
 * ``polish = k > 0`` re-integrates the final f (forward passes only) from k times
   the stroke and surface samples of one step, ``polish_rounds`` times, optionally
-  with the stroke strip (``polish_strip``) and a low-pass: less Monte-Carlo noise in
-  the splat and, with the strip, no shrinking between smooth strokes. With
+  with the stroke strip (``polish_strip``): less Monte-Carlo noise in the splat and,
+  with the strip, no shrinking between smooth strokes. With
   ``average_from < 1`` its g is the running mean of the network's parameters over the
   full stage from that fraction on (stochastic weight averaging), which has less of
   the last steps' noise than the last step's network, and it starts from the running
@@ -95,47 +87,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from curvenet.core.geometry import face_normals_areas, sample_surface
 from curvenet.core.result import MeshResult
 from curvenet.core.strokes import check_strokes
-from curvenet.core.tolerances import COINCIDENT_REL, NORM_EPS, TINY_F32
+from curvenet.core.tolerances import NORM_EPS
 
+from .flowfit import FlowFit
+from .frame import Frame
 from .presets import FlowConfig, get_config
-from .training import Stage, Step, seeded, torch_device, train
+from .training import torch_device, train
 
-__all__ = ["FlowResult", "fit_flow_surface", "StrokeSampler", "sample_surface_cells",
-           "sample_surface_marching_cubes", "Frame"]
-
-_TERMS = ("total", "align", "smooth", "data", "eik", "curl", "normal")
-
-
-@dataclass
-class Frame:
-    """World <-> unit-cube map of the padded box.
-
-    Attributes
-    ----------
-    box_min : (3,) float64, world corner of the padded cube
-    side : float, world side length of the cube
-    """
-
-    box_min: np.ndarray
-    side: float
-
-    @classmethod
-    def from_points(cls, points: np.ndarray, padding: float) -> "Frame":
-        lo, hi = points.min(0), points.max(0)
-        ext = float((hi - lo).max())
-        if not ext > 0:
-            raise ValueError("strokes have a zero-size bounding box")
-        side = ext * (1.0 + 2.0 * padding)
-        return cls((lo + hi) / 2.0 - side / 2.0, side)
-
-    def to_unit(self, x):
-        return (np.asarray(x, float) - self.box_min) / self.side
-
-    def to_world(self, u):
-        return np.asarray(u, float) * self.side + self.box_min
+__all__ = ["FlowResult", "fit_flow_surface"]
 
 
 @dataclass(repr=False, kw_only=True)
@@ -173,121 +134,6 @@ class FlowResult(MeshResult):
         u = (np.asarray(points, float) - self.origin) / (self.spacing * n) + 0.5 / n
         return interpolate(torch.from_numpy(self.f_grid.astype(np.float64)),
                            torch.from_numpy(u)).numpy()
-
-
-class StrokeSampler:
-    """Uniform arc-length Monte-Carlo samples with unit tangents on polylines.
-
-    Parameters
-    ----------
-    strokes_unit : list of (n_i, 3) float64, unit-cube coordinates
-    device, dtype : torch placement of the samples
-    """
-
-    def __init__(self, strokes_unit, device, dtype):
-        import torch
-        a = np.vstack([s[:-1] for s in strokes_unit])
-        b = np.vstack([s[1:] for s in strokes_unit])
-        length = np.linalg.norm(b - a, axis=1)
-        ok = length > 0
-        if not ok.any():
-            raise ValueError("strokes have zero total length")
-        a, b, length = a[ok], b[ok], length[ok]
-        self.total_length = float(length.sum())
-        self.a = torch.as_tensor(a, device=device, dtype=dtype)
-        self.d = torch.as_tensor(b - a, device=device, dtype=dtype)
-        self.t = torch.as_tensor((b - a) / length[:, None], device=device, dtype=dtype)
-        self.cum = torch.as_tensor(np.cumsum(length) / length.sum(), device=device, dtype=dtype)
-
-    def sample(self, n: int, gen):
-        """``(points (n, 3), tangents (n, 3))`` distributed uniformly by length."""
-        import torch
-        r = torch.rand(n, generator=gen, device=self.a.device, dtype=self.a.dtype)
-        seg = torch.searchsorted(self.cum, r).clamp(max=len(self.cum) - 1)
-        s = torch.rand(n, 1, generator=gen, device=self.a.device, dtype=self.a.dtype)
-        return self.a[seg] + s * self.d[seg], self.t[seg]
-
-
-def sample_surface_cells(f_grid, n: int, gen, *, newton_steps: int = 2):
-    """Samples on the zero level of a node grid, computed on its device.
-
-    Random points in uniformly chosen sign-change cells, moved onto the zero set
-    of the trilinear interpolant by Newton steps (each clamped to one cell).
-
-    Parameters
-    ----------
-    f_grid : (res, res, res) tensor
-    n : int
-    gen : torch.Generator on the grid's device
-
-    Returns
-    -------
-    points : (n, 3) unit-cube coordinates, or None when f does not cross zero
-    """
-    import torch
-    import torch.nn.functional as F
-
-    from .poisson import interpolate
-    res = f_grid.shape[0]
-    f5 = f_grid.detach()[None, None]
-    cmax = F.max_pool3d(f5, 2, stride=1)[0, 0]
-    cmin = -F.max_pool3d(-f5, 2, stride=1)[0, 0]
-    cells = torch.nonzero((cmin < 0) & (cmax > 0))                # (K, 3)
-    if len(cells) == 0:
-        return None
-    pick = torch.randint(len(cells), (n,), generator=gen, device=f_grid.device)
-    jitter = torch.rand(n, 3, generator=gen, device=f_grid.device, dtype=f_grid.dtype)
-    p = (cells[pick].to(f_grid.dtype) + 0.5 + jitter) / res
-    h = 1.0 / res
-    for _ in range(newton_steps):
-        v, gr = interpolate(f5[0, 0], p, with_gradient=True)
-        step = (v / (gr * gr).sum(-1).clamp(min=NORM_EPS)).unsqueeze(-1) * gr
-        norm = step.norm(dim=-1, keepdim=True)
-        step = step * torch.clamp(h / norm.clamp(min=TINY_F32), max=1.0)
-        p = p - step
-    return p.clamp(0.0, 1.0)
-
-
-def sample_surface_marching_cubes(f_grid, n: int, rng: np.random.Generator):
-    """Area-uniform samples on the scikit-image marching-cubes mesh of f (host).
-
-    Returns ``(n, 3)`` unit-cube points as a numpy array, or None.
-    """
-    from .extract import marching_cubes_world
-    res = f_grid.shape[0]
-    V, Fc = marching_cubes_world(f_grid.detach().cpu().numpy(), np.full(3, 0.5 / res), 1.0 / res)
-    if len(Fc) == 0:
-        return None
-    return _sample_triangles(V, Fc, n, rng)
-
-
-def _sample_triangles(V, F, n, rng):
-    """``n`` area-uniform points ``(n, 3)`` on the mesh ``(V, F)``, or None if all degenerate."""
-    areas = face_normals_areas(V, F)[1]
-    if not areas.sum() > 0:
-        return None
-    return sample_surface(V, F, n, rng, areas=areas)[0]
-
-
-def _prefit_targets(init_mesh, frame: Frame, sigma, rng, n=20000):
-    """Unit-cube points and targets sigma * grad SDF of a mesh (refinement)."""
-    import igl
-    V = frame.to_unit(np.asarray(init_mesh[0], float))
-    F = np.asarray(init_mesh[1], dtype=np.int64)
-    if V.ndim != 2 or V.shape[1] != 3 or F.ndim != 2 or F.shape[1] != 3 or len(F) == 0:
-        raise ValueError("init_mesh must be (vertices (V, 3), faces (F, 3)) with F >= 1")
-    surf = _sample_triangles(V, F, n // 2, rng)
-    if surf is None:
-        raise ValueError("init_mesh has only degenerate faces")
-    near = surf + rng.normal(scale=0.02, size=surf.shape)
-    vol = rng.random((n - n // 2, 3))
-    P = np.clip(np.vstack([near, vol]), 0.0, 1.0)
-    S, _, C, N = igl.signed_distance(P, V, F, sign_type=igl.SIGNED_DISTANCE_TYPE_PSEUDONORMAL)
-    d = P - C
-    dn = np.linalg.norm(d, axis=1, keepdims=True)
-    grad = np.where(dn > COINCIDENT_REL, d / np.maximum(dn, NORM_EPS) * np.sign(S)[:, None], N)
-    grad /= np.maximum(np.linalg.norm(grad, axis=1, keepdims=True), NORM_EPS)
-    return P, sigma * grad, surf
 
 
 def _check_strokes(strokes, labels):
@@ -378,318 +224,10 @@ def _check_anchors(anchors):
     return pts, nrm / length
 
 
-class _FlowFit:
-    """One flow fit: the network, the samplers, the Poisson solver and the current f.
-
-    Its step functions (:meth:`stages`) are run by :func:`neural.training.train`.
-    """
-
-    def __init__(self, strokes, cfg: FlowConfig, dev, seed: int, init_mesh, anchors=None):
-        import torch
-
-        from .poisson import PoissonSolver
-        from .siren import GradientSiren
-
-        self.cfg, self.dev = cfg, dev
-        self.dtype = torch.float64 if cfg.dtype == "float64" else torch.float32
-        self.frame = Frame.from_points(np.vstack(strokes + ([] if anchors is None
-                                                            else [anchors[0]])), cfg.padding)
-        strokes_unit = [self.frame.to_unit(s) for s in strokes]
-        self.gen, self.rng = seeded(seed, dev)
-        self.net = GradientSiren(cfg.width, cfg.hidden_layers, cfg.omega_0).to(
-            device=dev, dtype=self.dtype)
-        self.sampler = StrokeSampler(strokes_unit, dev, self.dtype)
-        self.solver = PoissonSolver(cfg.res, device=dev, dtype=self.dtype,
-                                    smooth_cells=cfg.smooth_cells, boundary=cfg.boundary)
-        self.f = None                  # the last solved f (unit-cube grid)
-        self.lam = None                # d(data loss) / d(splat), for poisson_every > 1
-        self.data = float("nan")       # the last solved data loss
-        self.averaged = None           # AveragedModel of the net (average_from < 1, polish)
-        self.f_mean = None             # running mean of the solved f over the same steps
-        self.anchors = None if anchors is None else tuple(
-            torch.as_tensor(a, device=dev, dtype=self.dtype)
-            for a in (self.frame.to_unit(anchors[0]), anchors[1]))
-        self.prefit = None
-        if init_mesh is not None:
-            P, target, mesh_surf = _prefit_targets(init_mesh, self.frame, cfg.sigma, self.rng)
-            self.prefit = (torch.as_tensor(P, device=dev, dtype=self.dtype),
-                           torch.as_tensor(target, device=dev, dtype=self.dtype), mesh_surf)
-        names = ("prefit",) if init_mesh is not None else ("init",)
-        self.history = {name: {t: [] for t in _TERMS} for name in names + ("full",)}
-
-    def geometric_stage(self) -> Stage:
-        """Fit g to ``sigma (x - c) / |x - c|`` (c: stroke centroid); see the module notes."""
-        import torch
-        cfg, gen, dev, dtype = self.cfg, self.gen, self.dev, self.dtype
-        c = self.sampler.sample(4096, gen)[0].mean(0)
-        n = max(cfg.n_volume, 1000)
-
-        def step(k):
-            x = torch.cat([torch.rand(n, 3, generator=gen, device=dev, dtype=dtype),
-                           self.sampler.sample(n, gen)[0]])
-            d = x - c
-            target = cfg.sigma * d / d.norm(dim=-1, keepdim=True).clamp(min=1e-6)  # local: x = c
-            return Step(((self.net(x) - target) ** 2).sum(-1).mean())
-
-        return Stage("geometric", cfg.geometric_init_steps, step)
-
-    def stages(self) -> list:
-        """The prefit (``init_mesh`` given) or initialisation stage, then the full stage."""
-        cfg = self.cfg
-        if self.prefit is not None:
-            first = Stage("prefit", cfg.prefit_steps, self._prefit_step)
-            full = Stage("full", cfg.steps, self._flow_step("full", cfg.steps),
-                         start=self._bootstrap)
-        else:
-            first = Stage("init", cfg.init_steps, self._flow_step("init", cfg.init_steps))
-            full = Stage("full", cfg.steps, self._flow_step("full", cfg.steps))
-        return [first, full]
-
-    def solve(self, points, values, normalize, need_adjoint, n_stroke=None, mass=None,
-              solver=None):
-        """Splat -> FFT Poisson -> Eq. 11; returns (f_grid, data loss, raw grid).
-
-        The first ``n_stroke`` (default ``cfg.n_stroke``) points are the data samples
-        (the stroke samples, then the anchors'); ``mass`` (optional, (M,)) weighs the
-        points in the splat; ``solver`` (default the fit's) solves.
-        """
-        from .losses import data_loss
-        from .poisson import interpolate, normalize_scale_shift, normalize_splat, splat
-        grid, wsum = splat(points, values, self.cfg.res, mass)
-        raw = grid
-        if need_adjoint:
-            raw.retain_grad()
-        if normalize:
-            grid = normalize_splat(grid, wsum)
-        f = (solver or self.solver).solve(grid)
-        f_s = interpolate(f, points[: n_stroke or self.cfg.n_stroke])
-        f, f_s = normalize_scale_shift(f, f_s)
-        return f, data_loss(f_s), raw
-
-    def polish(self, f):
-        """f re-integrated ``cfg.polish_rounds`` times with the trained g, without gradients.
-
-        Each round draws ``cfg.polish`` times the stroke and surface samples of a step
-        (the surface ones on the zero set of the round before), in the same proportion,
-        and splats them with the normalisation of the last step, leaving out the surface
-        samples within ``cfg.polish_strip`` cells of the strokes; the solve low-passes by
-        ``cfg.polish_smooth_cells``. The Monte-Carlo noise of the splat is down by about
-        ``sqrt(cfg.polish)``; the per-node normalisation sees ``cfg.polish`` times the
-        weight, so even one round without strip or low-pass is not quite a step's
-        field (``benchmarks/README.md``). g is the averaged network (:meth:`_average`)
-        if there is one, else the last step's; the first round's surface samples lie on
-        the zero set of the averaged f if there is one, else of ``f``.
-        """
-        import torch
-
-        from .poisson import PoissonSolver
-        cfg = self.cfg
-        normalize = cfg.steps - 1 >= int(cfg.normalize_from * cfg.steps)   # as the last step
-        solver = self.solver if cfg.polish_smooth_cells == cfg.smooth_cells else PoissonSolver(
-            cfg.res, device=self.dev, dtype=self.dtype, smooth_cells=cfg.polish_smooth_cells,
-            boundary=cfg.boundary)
-        net = self.net if self.averaged is None else self.averaged.module
-        f = f if self.f_mean is None else self.f_mean
-        with torch.no_grad():
-            for _ in range(cfg.polish_rounds):
-                x_s = self._data_points(cfg.polish)
-                x_u = sample_surface_cells(f, cfg.polish * cfg.n_surface, self.gen)
-                keep, mass = self._strip(x_s, x_u, cfg.polish_strip)
-                if keep is not None:
-                    x_u = x_u[keep]
-                pts = x_s if x_u is None else torch.cat([x_s, x_u])
-                vals = torch.cat([net(p) for p in pts.split(65536)])
-                f = self.solve(pts, vals, normalize, False, n_stroke=len(x_s), mass=mass,
-                               solver=solver)[0]
-        return f
-
-    def _average(self):
-        """Add the net's parameters (``torch.optim.swa_utils``) and the last solved f
-        (``self.f``, a (res, res, res) grid normalised by Eq. 11) to their running means.
-
-        Every step's f puts its stroke samples' mean at 0 and the box corner at +-1; each
-        is added signed so that the corner is +1 (g's orientation is the fit's choice),
-        so their mean does the same, and its zero set has less of the steps'
-        Monte-Carlo noise.
-        """
-        import torch
-        from torch.optim.swa_utils import AveragedModel
-        if self.averaged is None:
-            self.averaged = AveragedModel(self.net)
-        self.averaged.update_parameters(self.net)
-        n = int(self.averaged.n_averaged)
-        f = self.f * torch.sign(self.f[0, 0, 0])
-        self.f_mean = f if n == 1 else self.f_mean.add_(f - self.f_mean, alpha=1.0 / n)
-
-    def solve_strokes_only(self, mesh_points=None):
-        """f integrated from g at stroke samples (and ``mesh_points``), without gradients."""
-        import torch
-        with torch.no_grad():
-            pts = self._data_points(1)
-            n_data = len(pts)
-            if mesh_points is not None:
-                pts = torch.cat([pts, mesh_points])
-            return self.solve(pts, self.net(pts), False, False, n_stroke=n_data)[0]
-
-    def _anchor_sample(self, factor: int = 1):
-        """``factor * min(m, n_stroke)`` anchors drawn with replacement: (points, normals)."""
-        import torch
-        pts, nrm = self.anchors
-        idx = torch.randint(len(pts), (factor * min(len(pts), self.cfg.n_stroke),),
-                            generator=self.gen, device=self.dev)
-        return pts[idx], nrm[idx]
-
-    def _data_points(self, factor: int):
-        """``factor`` times a step's stroke samples, then as many times its anchors."""
-        import torch
-        pts, _ = self.sampler.sample(factor * self.cfg.n_stroke, self.gen)
-        if self.anchors is None:
-            return pts
-        return torch.cat([pts, self._anchor_sample(factor)[0]])
-
-    def _anchor_terms(self, vals, x_s, g_s):
-        """Anchor samples after the stroke samples (data, splat, Eikonal); their normal term."""
-        import torch
-
-        from .losses import normal_loss
-        if self.anchors is None:
-            return x_s, g_s
-        x_a, n_a = self._anchor_sample()
-        g_a = self.net(x_a)
-        vals["normal"] = normal_loss(g_a, n_a)
-        return torch.cat([x_s, x_a]), torch.cat([g_s, g_a])
-
-    def _bootstrap(self):
-        """f from the prefitted g on strokes + init-mesh samples (start of the full stage)."""
-        import torch
-        ms = torch.as_tensor(self.prefit[2][: self.cfg.n_surface], device=self.dev,
-                             dtype=self.dtype)
-        self.f = self.solve_strokes_only(ms)
-        return self.f
-
-    def _surface_samples(self, n):
-        import torch
-        if self.f is None:
-            return None
-        if self.cfg.surface_sampler == "cells":
-            return sample_surface_cells(self.f, n, self.gen)
-        p = sample_surface_marching_cubes(self.f, n, self.rng)
-        return None if p is None else torch.as_tensor(p, device=self.dev, dtype=self.dtype)
-
-    def _prefit_step(self, k):
-        import torch
-        P, target, _ = self.prefit
-        idx = torch.randint(len(P), (self.cfg.n_volume,), generator=self.gen, device=self.dev)
-        loss = ((self.net(P[idx]) - target[idx]) ** 2).sum(-1).mean()
-        row = self._row({"total": loss})
-        return Step(loss, dict(zip(_TERMS, row)), after=lambda: self._record("prefit", k, row))
-
-    def _flow_step(self, stage, n_steps):
-        """Step function of the initialisation (strokes only) or full stage (Eq. 13)."""
-        import torch
-
-        from .losses import alignment_loss, curl_loss
-        from .poisson import splat
-        cfg, net, gen = self.cfg, self.net, self.gen
-        full = stage == "full"
-
-        def step(k):
-            x_s, t_s = self.sampler.sample(cfg.n_stroke, gen)
-            x_v = torch.rand(cfg.n_volume, 3, generator=gen, device=self.dev, dtype=self.dtype)
-            g_sv, G_sv = net.jet(torch.cat([x_s, x_v]), order=1)
-            g_s, G_s = g_sv[: cfg.n_stroke], G_sv[: cfg.n_stroke]
-            x_u = self._surface_samples(cfg.n_surface) if full else None
-            vals = {"align": alignment_loss(g_s, G_s, t_s, cfg.align_penalty),
-                    "curl": curl_loss(G_sv[cfg.n_stroke:])}
-            x_s, g_s = self._anchor_terms(vals, x_s, g_s)
-            pts, gv, mass = self._surface_terms(vals, x_u, x_s, g_s)
-            if cfg.splat_volume:
-                pts, gv = torch.cat([pts, x_v]), torch.cat([gv, g_sv[cfg.n_stroke:]])
-                if mass is not None:
-                    mass = torch.cat([mass, mass.new_ones(len(x_v))])
-            normalize = full and k >= int(cfg.normalize_from * n_steps)
-            average = full and cfg.polish > 0 and k >= int(cfg.average_from * n_steps)
-            do_solve = (k % cfg.poisson_every == 0) or k == n_steps - 1 or self.lam is None
-            if do_solve:
-                f, vals["data"], raw = self.solve(pts, gv, normalize, cfg.poisson_every > 1,
-                                                  n_stroke=len(x_s), mass=mass)
-                data_term = cfg.w_data * vals["data"]
-            else:
-                data_term = (self.lam * splat(pts, gv, cfg.res, mass)[0]).sum()
-            loss = (cfg.w_align * vals["align"] + cfg.w_curl * vals["curl"]
-                    + cfg.w_eik * vals["eik"] + data_term)
-            for term, w in (("smooth", cfg.w_smooth), ("normal", cfg.w_normal)):
-                if term in vals:
-                    loss = loss + w * vals[term]
-            vals["total"] = loss
-            row = self._row(vals)
-            if do_solve:
-                row[3] = float(vals["data"].detach())
-                f = f.detach()
-            else:
-                row[3] = self.data
-
-            def after():
-                if do_solve:
-                    if cfg.poisson_every > 1:
-                        self.lam = raw.grad.detach()
-                    self.f, self.data = f, row[3]
-                if average:
-                    self._average()
-                self._record(stage, k, row)
-
-            return Step(loss, dict(zip(_TERMS, row)), state=f if do_solve else None,
-                        after=after)
-
-        return step
-
-    def _strip(self, x_s, x_u, cells):
-        """``(keep, mass)`` of :func:`neural.poisson.stroke_strip` (``cells`` wide);
-        ``(None, None)``, all splatted with mass 1, without x_u or strip."""
-        if x_u is None or cells <= 0:
-            return None, None
-        from .poisson import stroke_strip
-        return stroke_strip(x_s, x_u, cells / self.cfg.res)
-
-    def _surface_terms(self, vals, x_u, x_s, g_s):
-        """Smoothness and Eikonal terms into ``vals``; the points, g and masses to splat."""
-        import torch
-
-        from .losses import eikonal_loss, smoothness_loss, smoothness_loss_autograd
-        cfg, net = self.cfg, self.net
-        if x_u is None:
-            vals["eik"] = eikonal_loss(g_s, cfg.sigma)
-            return x_s, g_s, None
-        if cfg.w_smooth > 0 and cfg.smooth_mode == "jet":
-            g_u, G_u, H_u = net.jet(x_u, order=2)
-            vals["smooth"] = smoothness_loss(g_u, G_u, H_u)
-        else:
-            g_u = net(x_u)
-            if cfg.w_smooth > 0:
-                vals["smooth"] = smoothness_loss_autograd(net, x_u)
-        vals["eik"] = eikonal_loss(torch.cat([g_u, g_s]), cfg.sigma)
-        keep, mass = self._strip(x_s, x_u, cfg.stroke_strip)
-        if keep is not None:
-            x_u, g_u = x_u[keep], g_u[keep]
-        return torch.cat([x_s, x_u]), torch.cat([g_s, g_u]), mass
-
-    def _row(self, vals) -> list:
-        """The loss terms of :data:`_TERMS` as floats (NaN where not computed)."""
-        import torch
-        nan = torch.full((), float("nan"), device=self.dev, dtype=self.dtype)
-        return torch.stack([vals[t].detach() if t in vals else nan for t in _TERMS]).tolist()
-
-    def _record(self, stage, k, row):
-        for t, v in zip(_TERMS, row):
-            self.history[stage][t].append(v)
-        if not all(np.isfinite(v) for v in row if v == v):
-            raise FloatingPointError(f"non-finite loss at {stage} step {k}: {row}")
-
-
 def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_boundary, quality,
          anchors=None):
     t_start = time.perf_counter()
-    fit = _FlowFit(strokes, cfg, dev, seed, init_mesh, anchors)
+    fit = FlowFit(strokes, cfg, dev, seed, init_mesh, anchors)
     stages = fit.stages()
     interrupted = False
     if init_mesh is None and cfg.geometric_init_steps > 0:
@@ -719,8 +257,8 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
                       history=fit.history)
 
 
-def _polished(fit: _FlowFit, f, mesh, strokes, labels, cut_boundary):
-    """The polished surface (:meth:`_FlowFit.polish`) if it holds as much of the strokes.
+def _polished(fit: FlowFit, f, mesh, strokes, labels, cut_boundary):
+    """The polished surface (:meth:`FlowFit.polish`) if it holds as much of the strokes.
 
     ``mesh`` is :func:`_extract`'s tuple for the last step's ``f``. The re-integration
     removes Monte-Carlo noise and, with the strip, the shrinking of the surface between

@@ -17,65 +17,34 @@ the Eikonal term of Sec. 4.3, 12 (curl), 13 (weights).
 
 from __future__ import annotations
 
-import torch
 
 from curvenet.core.tolerances import NORM_EPS
 
-from .geometry import alignment_cos4, covariant_tv, curl, second_fundamental_form, tangent_frame
+from .geometry import alignment_cos4, covariant_tv, curl
 
-__all__ = ["alignment_loss", "smoothness_loss", "smoothness_loss_autograd", "data_loss",
-           "eikonal_loss", "curl_loss", "normal_loss"]
+__all__ = ["alignment_loss", "smoothness_loss", "data_loss", "eikonal_loss", "curl_loss",
+           "normal_loss"]
 
 
-def alignment_loss(g, G, tangents, penalty: str = "square"):
+def alignment_loss(g, G, tangents):
     """Eq. 4: mean of ``(cos 4 alpha - 1)^2`` over stroke samples.
 
     Parameters
     ----------
     g : (N, 3), G : (N, 3, 3), tangents : (N, 3)
-    penalty : {"square", "abs"}
-        ``"square"`` is Eq. 4; ``"abs"`` charges ``|cos 4 alpha - 1|``, as the published
-        code does (its gradient does not vanish as a stroke comes into line).
 
     Returns
     -------
-    scalar tensor in ``[0, 4]`` (``"abs"``: ``[0, 2]``); samples with no defined
-    principal direction (umbilic or tangent normal to the surface) contribute 0.
+    scalar tensor in ``[0, 4]``; samples with no defined principal direction (umbilic
+    or tangent normal to the surface) contribute 0.
     """
     cos4, _ = alignment_cos4(g, G, tangents)
-    return ((cos4 - 1.0) ** 2 if penalty == "square" else (cos4 - 1.0).abs()).mean()
+    return ((cos4 - 1.0) ** 2).mean()
 
 
 def smoothness_loss(g, G, H):
     """Eq. 5: mean over surface samples of ``||nabla_S II||_F`` (covariant TV)."""
     return covariant_tv(g, G, H).mean()
-
-
-def smoothness_loss_autograd(net, x, *, eps: float = NORM_EPS):
-    """Eq. 5 by double backward instead of the closed-form jet (same value).
-
-    ``II`` is built from ``net.jet(x, order=1)`` and differentiated with
-    respect to ``x`` by autograd (6 distinct components, ``create_graph``), then
-    projected as in :func:`neural.geometry.covariant_tv`. Slower; kept as the
-    reference the jet version is tested against and for ``smooth_mode="autograd"``.
-    """
-    x = x.detach().requires_grad_(True)
-    g, G = net.jet(x, order=1)
-    II = second_fundamental_form(g, G)
-    grads = {}
-    for i in range(3):
-        for j in range(i, 3):
-            grads[i, j] = torch.autograd.grad(II[:, i, j].sum(), x, create_graph=True)[0]
-    D = torch.stack([torch.stack([grads[min(i, j), max(i, j)] for j in range(3)], 1)
-                     for i in range(3)], 1)                       # (N, 3, 3, 3): d II_ij / d x_k
-    n = g / g.norm(dim=-1, keepdim=True).clamp(min=NORM_EPS)
-    P = torch.eye(3, dtype=g.dtype, device=g.device) - n.unsqueeze(-1) * n.unsqueeze(-2)
-    t1, t2 = tangent_frame(n)
-    total = 0.0
-    for t in (t1, t2):
-        Dt = P @ torch.einsum("nijk,nk->nij", D, t) @ P
-        total = total + (Dt * Dt).sum((-1, -2))
-    return torch.sqrt(total + eps).mean()
 
 
 def data_loss(f_strokes):

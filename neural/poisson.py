@@ -220,9 +220,6 @@ class PoissonSolver:
     device : str or torch.device
     dtype : torch.dtype
         Real dtype of the fields.
-    smooth_cells : float
-        Optional Gaussian low-pass of the solution, standard deviation in cells
-        (0 = the exact Eq. 10).
     boundary : {"periodic", "dirichlet"}
         ``"periodic"``: the unit cube is a 3-torus (Eq. 8-10). ``"dirichlet"``:
         f = 0 on the cube's walls: f in sines, exact projections by dense
@@ -244,14 +241,13 @@ class PoissonSolver:
     0.0
     """
 
-    def __init__(self, res: int, *, device="cpu", dtype=torch.float32, smooth_cells: float = 0.0,
-                 boundary: str = "periodic"):
+    def __init__(self, res: int, *, device="cpu", dtype=torch.float32, boundary: str = "periodic"):
         if boundary not in ("periodic", "dirichlet"):
             raise ValueError(f"boundary must be 'periodic' or 'dirichlet', got {boundary!r}")
         self.res, self.boundary = int(res), boundary
         self.device, self.dtype = device, dtype
         if boundary == "dirichlet":
-            self._init_sine(smooth_cells)
+            self._init_sine()
             return
         n = self.res
         u = torch.fft.fftfreq(n, d=1.0 / n, dtype=torch.float64)
@@ -265,15 +261,12 @@ class PoissonSolver:
             + (torch.fft.rfftfreq(n, d=1.0 / n, dtype=torch.float64) ** 2).view(1, 1, -1)
         inv = torch.where(uu > 0, 1.0 / (-2.0 * math.pi * uu.clamp(min=TINY_F32)),
                           torch.zeros_like(uu))
-        if smooth_cells > 0:
-            s = smooth_cells / n
-            inv = inv * torch.exp(-2.0 * math.pi ** 2 * s * s * uu)
         # u / (-2 pi |u|^2) per axis, real: (3, n, n, n//2+1); the factor i is applied once
         op = torch.stack([(ux * inv).expand(n, n, -1), (uy * inv).expand(n, n, -1),
                           (uz * inv).expand(n, n, -1)])
         self._op = op.to(device=device, dtype=dtype).contiguous()
 
-    def _init_sine(self, smooth_cells: float) -> None:
+    def _init_sine(self) -> None:
         """Bases of the Dirichlet solve: f = sum_k a_k prod_axes sin(pi k x), k = 1..n.
 
         Nodes sit at ``x_i = (i + 1/2) / n``, where the sine modes ``k = 1..n``
@@ -289,9 +282,6 @@ class PoissonSolver:
         Cp = torch.cat([C / (C * C).sum(1, keepdim=True), torch.zeros(1, n, dtype=torch.float64)])
         kk = k.view(n, 1, 1) ** 2 + k.view(1, n, 1) ** 2 + k.view(1, 1, n) ** 2
         inv = 1.0 / (math.pi * kk)
-        if smooth_cells > 0:    # sine mode k has k / 2 cycles per unit length
-            s = smooth_cells / n
-            inv = inv * torch.exp(-2.0 * math.pi ** 2 * s * s * kk / 4.0)
 
         def put(t):
             return t.to(device=self.device, dtype=self.dtype).contiguous()

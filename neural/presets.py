@@ -3,81 +3,53 @@
 A :class:`FlowConfig` holds the settings of the flow-aligned surfacing (Zhang, Wang,
 Bessmeltsev 2025; :func:`neural.flow.fit_flow_surface`), a :class:`CreaseConfig` those
 of the crease refit (Niu et al. 2025; :func:`neural.creases.crease_refine`). Each has
-three presets, ``draft``, ``default`` and ``paper`` (``fit_flow_surface(..., res=96)``
-overrides one field of the chosen preset).
+three presets, ``draft``, ``default`` and ``paper``; a keyword overrides one field of
+the chosen preset (``fit_flow_surface(..., res=96)``).
 
 Notes
 -----
-Flow presets. ``paper`` reproduces the published settings (Sec. 4.3, 5.1, 5.2): a
-4 x 256 SIREN with omega_0 = 30, 10k / 15k / 15k Monte-Carlo samples on strokes,
-surface and volume, 200 initialisation + 800 full Adam steps, a 256^3 grid on the
-bounding box padded by 20 %, loss weights 1, 0.01, 30, 7, 7 and Eikonal sigma = 0.5.
-The learning rate and gradient clipping are not given in the paper; it takes the
-published code's values (Adam lr 5e-5, clip 10). It is meant for a GPU.
+Flow presets:
 
-``draft`` is sized for a short CPU run (a 64^3 grid and a small network), ``default``
-balances quality and time (128^3) and is the better choice on a GPU. Both raise the
-smoothness weight from the paper's 0.01 to 0.1 and start from a radial geometric
-initialisation: with their short budgets the paper's weight leaves mid-frequency
-bumps, and the plain SIREN initialisation starts from a rough field they cannot
-recover from. Every preset splats the stroke samples on top of the surface
-samples, as the paper and the published code do. That extra density along the
-strokes (a curved line of normals) shifts the zero level Eq. 11 takes at the
-strokes, so between the strokes the surface moves towards the concave side: rough
-spheres shrink between their strokes by about a quarter of a cell, most of the
-Chamfer distance left on them. ``stroke_strip`` (off in every preset) splats the
-stroke samples in place of the surface samples near them in every step instead:
-the spheres stay round, but the extra density is also what holds a surface on
-strokes where it folds (the open rims of vns/dress.obj) and on most sketches whose
-strokes leave much of the surface open, and without it the surface leaves them
-(``benchmarks/README.md``). ``default`` therefore trains as the paper does and then
-polishes: four re-integrations of the trained g with the strip, each from four
-times a step's samples, the surface ones drawn on the zero set of the one before
-(``polish=4, polish_rounds=4, polish_strip=1``), with the network's parameters
-averaged over the last 40 % of the full stage (``average_from=0.6``, stochastic
-weight averaging: less of the last steps' noise), the first round's surface samples
-drawn on the zero set of the mean of those steps' f (a round moves a surface only
-part of the way, and a single step's zero set carries its splat's Monte-Carlo
-bumps). The polished surface is returned
-only when it holds at least as much of the strokes (stroke fidelity) as the last
-step's: it does on smooth closed sketches (rough spheres: no shrinking between the
-strokes; vns torus and trebol_flowrep) and does not where the extra density held the
-surface (dress and most other vns sketches keep the last step's surface, unchanged).
-Every re-integration leans the surface towards g's own potential, which keeps some
-of the radial initialisation: on rough ellipsoids and tori it moves the surface a
-little off the strokes (Chamfer up by about 3e-4 with the averaged network, 5e-4
-without) while the F-score stays at or above the last step's.
-``paper`` keeps the published constants (no variant tried was better on
-every test shape). All presets solve the Poisson equation every ``poisson_every``
-steps and use the linearised data term in between (see :mod:`neural.flow`).
-``benchmarks/README.md`` has the scores and timings of the presets and of the
-variants tried.
+- ``draft``: a short CPU run (64^3 grid, a 2 x 64 SIREN, 40 + 100 steps), about a
+  minute per sketch on two cores.
+- ``default``: 128^3 and a 2 x 96 SIREN, 60 + 200 steps, then the polish; the better
+  choice on a GPU as well.
+- ``paper``: the published settings (Sec. 4.3, 5.1, 5.2): a 4 x 256 SIREN with
+  omega_0 = 30, 10k / 15k / 15k Monte-Carlo samples on strokes, surface and volume,
+  200 initialisation + 800 full Adam steps, a 256^3 grid on the bounding box padded by
+  20 % (Sec. 4.4.1), loss weights 1, 0.01, 30, 7, 7 (Eq. 13) and Eikonal sigma = 0.5.
+  The paper gives no learning rate or gradient clipping; it takes the published code's
+  (Adam lr 5e-5, clip 10). It is meant for a GPU.
 
-The published code (zytadam/Variational-Neural-Surfacing-of-3D-Sketches) differs
-from the paper's text and from these presets in ways ``paper`` does not copy: its
-data term is the mean of f^2 (not |f|) with f scaled so the box corner is 0.5; its
-FFT solve applies a Gaussian low-pass of about one cell (``smooth_cells`` here, off
-by default); it normalises the splat per node to a unit vector in the first 100 and
-after 600 of its 1000 steps and not in between (here: divided by the sample weight,
-from ``normalize_from`` on); its Eikonal term is one-sided (only ``|g| < sigma`` is
-charged, L1); its smoothness term is scaled by the distance of the surface samples
-to the strokes and leaves out samples on the strokes after step 600; its alignment
-term is ``|cos 4a - 1|`` at stroke samples jittered by 0.002; its SIREN takes the
-unit-cube coordinates as they are (here mapped to [-1, 1], twice the first layer's
-frequency); it puts the sketch's longest side at 0.7 of the box (padding 0.21). It
-draws 10k stroke, 15k surface (marching-cubes mesh) and 15k volume samples per step.
-Measured against ``default`` (``benchmarks/README.md``): the data term, the low-pass,
-the splat normalisation, the sample proportions, the one-sided Eikonal term, the
-alignment term (``align_penalty="abs"``) and the box; each helped the spheres or some
-sketches and cost others stroke fidelity, so none is in a preset. Not measured: the
-distance-scaled smoothness term (its weight has no counterpart here without choosing
-a reference sketch), the jitter of the alignment samples and the SIREN's input scale.
+Besides their budget (network, grid, samples, steps), ``draft`` and ``default`` depart
+from the paper in:
+
+- smoothness weight 0.1, not 0.01: with their short budgets the paper's weight leaves
+  mid-frequency bumps;
+- a radial geometric initialisation (``geometric_init_steps``): the plain SIREN
+  initialisation starts from a rough, curl-heavy field that a short budget does not
+  recover from;
+- ``default`` only, the polish (``polish``, ``polish_rounds``, ``polish_strip``,
+  ``average_from``): f re-integrated from the network averaged over the last 40 % of
+  the full stage, with the stroke samples in place of the surface samples next to
+  them, returned only when it holds at least as much of the strokes as the last
+  step's surface: the stroke samples splatted on top of the surface ones shrink smooth
+  surfaces between their strokes, and the polish takes that back where it does not
+  move the surface off the strokes.
+
+Crease presets: ``draft`` for a CPU, ``default`` a 4 x 256 MLP trained 3,000 steps,
+``paper`` the network size and the 15,000 steps of the paper's 3D examples (Sec. 5),
+with the Softplus activation of Sec. 4.
+
+``benchmarks/README.md`` has the scores and timings of the presets, the variants tried
+against them, and how the published code differs from both.
 
 References
 ----------
 Zhang, Wang, Bessmeltsev, "Variational Neural Surfacing of 3D Sketches",
-SIGGRAPH Asia 2025, Sec. 4.3 (weights), 5.1 (samples), 5.2 (steps).
-Niu et al. 2025, "SharpNet", Sec. 5 (network size and training of the 3D examples).
+SIGGRAPH Asia 2025, Sec. 4.3 (weights), 4.4.1 (box), 5.1 (samples), 5.2 (steps).
+Niu et al. 2025, "SharpNet", Sec. 4 (activation), Sec. 5 (network size and training of
+the 3D examples).
 """
 
 from __future__ import annotations
@@ -123,42 +95,27 @@ class FlowConfig:
         Adam learning rate. grad_clip : float, gradient-norm clip (0 = off).
     w_align, w_smooth, w_data, w_eik, w_curl : float
         Loss weights of Eq. 13 (paper: 1, 0.01, 30, 7, 7).
-    align_penalty : str
-        ``"square"`` (Eq. 4: ``(cos 4 alpha - 1)^2``) or ``"abs"`` (``|cos 4 alpha - 1|``,
-        the published code's) for the alignment term.
     w_normal : float
         Weight of the anchors' normal term (:func:`neural.losses.normal_loss`; only
         with ``anchors``, not in the paper).
     sigma : float
         Eikonal target gradient norm (paper: 0.5, Sec. 4.3).
     poisson_every : int
-        Solve the Poisson equation every this many steps (1 = every step).
+        Solve the Poisson equation every this many steps (1 = every step, as in every
+        preset); the steps between use the data term's first-order linearisation
+        (:mod:`neural.flow`), which skips the solve.
     normalize_from : float
         Fraction of the full stage after which the rasterised g is normalised
         per grid point (Sec. 5.1, "once the optimization has stabilized").
-    smooth_cells : float
-        Gaussian low-pass of the Poisson solution, standard deviation in grid
-        cells (0 = the exact Eq. 10).
-    surface_sampler : str
-        ``"cells"`` (zero-crossing cells + Newton projection, on the device) or
-        ``"marching_cubes"`` (scikit-image, on the host).
-    smooth_mode : str
-        ``"jet"`` (closed-form third derivatives of the SIREN) or ``"autograd"``
-        (double backward) for the covariant derivative of II (Eq. 18).
     prefit_steps : int
         Steps fitting g to sigma * grad SDF of ``init_mesh`` (refinement only).
     geometric_init_steps : int
         Steps fitting g to the gradient of a sphere around the strokes before
         the initialisation stage (0 = plain SIREN initialisation, as the paper
         text; the published code uses a sphere initialisation).
-    splat_volume : bool
-        Also splat g at the volume samples into the Poisson right-hand side, so
-        that f follows g away from the surface too (the paper splats stroke and
-        surface samples only, Sec. 5.1). Off by default: it does not keep a zero
-        set from closing through the periodic box, because the smoothness term
-        itself prefers that surface.
     dtype : str
-        ``"float32"`` or ``"float64"``.
+        ``"float32"`` (every preset) or ``"float64"``: the precision of the network,
+        the samples and the grids.
     polish : int
         After the last step, integrate f again (no gradients) from this many times
         the stroke and surface samples of a step, ``polish_rounds`` times, each round
@@ -166,25 +123,19 @@ class FlowConfig:
         last step's f. The polished surface is returned only when it holds at least
         as much of the strokes as the last step's (stroke fidelity, the share of
         stroke length within 1 % of the strokes' diagonal); ``report["polish"]``
-        gives both figures. Not in the paper (see the notes above).
+        gives both figures. Not in the paper (see the notes above: ``default``).
     polish_rounds : int
         Rounds of the polish (at least 1).
-    polish_smooth_cells : float
-        Gaussian low-pass of the polish's solves, standard deviation in grid cells
-        (the published code low-passes every solve by about one cell).
     polish_strip : float
-        ``stroke_strip`` of the polish's splats (cells; 0 = none).
+        Surface samples closer than this many grid cells to a stroke sample are left
+        out of the polish's splats and the stroke samples carry their mass
+        (:func:`neural.poisson.stroke_strip`); 0 splats every sample with mass 1.
     average_from : float
         Fraction of the full stage from which the network's parameters and the
         solved f are averaged (running means; stochastic weight averaging of the
         parameters) for the polish, which then integrates the averaged network's g
         from the averaged f's zero set; 1 = no averaging (the last step's
         network and f). Training itself is unchanged.
-    stroke_strip : float
-        Surface samples closer than this many grid cells to a stroke sample are
-        left out of the full stage's splat and the stroke samples carry their mass
-        (:func:`neural.poisson.stroke_strip`);
-        0 splats every sample with mass 1, as the paper and the published code do.
     """
 
     res: int = 128
@@ -206,23 +157,16 @@ class FlowConfig:
     w_eik: float = 7.0
     w_curl: float = 7.0
     w_normal: float = 7.0
-    align_penalty: str = "square"
     sigma: float = 0.5
     poisson_every: int = 1
     normalize_from: float = 0.6
-    smooth_cells: float = 0.0
-    surface_sampler: str = "cells"
-    smooth_mode: str = "jet"
     prefit_steps: int = 150
     geometric_init_steps: int = 100
-    splat_volume: bool = False
     dtype: str = "float32"
     polish: int = 0
     polish_rounds: int = 1
-    polish_smooth_cells: float = 0.0
     polish_strip: float = 0.0
     average_from: float = 1.0
-    stroke_strip: float = 0.0
 
     def as_dict(self) -> dict:
         """The settings as a plain dict (for reports)."""
@@ -240,9 +184,7 @@ PRESETS: dict[str, FlowConfig] = {
                         geometric_init_steps=0),
 }
 
-_CHOICES = {"align_penalty": ("square", "abs"), "boundary": ("periodic", "dirichlet"),
-            "surface_sampler": ("cells", "marching_cubes"), "smooth_mode": ("jet", "autograd"),
-            "dtype": ("float32", "float64")}
+_CHOICES = {"boundary": ("periodic", "dirichlet"), "dtype": ("float32", "float64")}
 
 
 def _from_preset(presets: dict, quality: str, overrides: dict, what: str):
@@ -301,7 +243,7 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
         if not getattr(cfg, name) > 0:
             raise ValueError(f"{name} must be positive, got {getattr(cfg, name)!r}")
     for name in ("w_align", "w_smooth", "w_data", "w_eik", "w_curl", "w_normal", "grad_clip",
-                 "smooth_cells", "polish_smooth_cells", "stroke_strip", "polish_strip"):
+                 "polish_strip"):
         if not getattr(cfg, name) >= 0:
             raise ValueError(f"{name} must be non-negative, got {getattr(cfg, name)!r}")
     for name in ("normalize_from", "average_from"):
@@ -333,8 +275,8 @@ def parse_setting(text: str) -> tuple[str, object]:
     --------
     >>> parse_setting("w_smooth=0.01")
     ('w_smooth', 0.01)
-    >>> parse_setting("splat_volume=yes")
-    ('splat_volume', True)
+    >>> parse_setting("boundary=dirichlet")
+    ('boundary', 'dirichlet')
     """
     name, sep, raw = text.partition("=")
     name, raw = name.strip(), raw.strip()
@@ -344,11 +286,6 @@ def parse_setting(text: str) -> tuple[str, object]:
     if name not in kinds:
         raise ValueError(f"unknown neural setting {name!r}; valid: {sorted(kinds)}")
     kind = kinds[name]
-    if kind is bool:
-        truth = {"true": True, "yes": True, "1": True, "false": False, "no": False, "0": False}
-        if raw.lower() not in truth:
-            raise ValueError(f"{name} takes true or false, got {raw!r}")
-        return name, truth[raw.lower()]
     try:
         return name, kind(raw)
     except ValueError:

@@ -15,7 +15,7 @@ import numpy as np
 from curvenet.core.result import MeshResult
 from curvenet.core.errors import InvalidParameterError
 
-from .bspline import ControlNet
+from .levels import ControlNet
 from .catmull_clark import edge_index, subdivision_step
 from .controlmesh import build_control_mesh
 from .creases import DEFAULT_CREASE_ANGLE, sharp_structure
@@ -68,7 +68,7 @@ class PatchMeshResult(MeshResult):
         Updated network curves when ``update_curves`` was asked for.
     control_vertices, control_quads : arrays or None
         The fitted control mesh (classical route only).
-    control_net : surfacing.bspline.ControlNet or None
+    control_net : surfacing.levels.ControlNet or None
         The fitted control mesh with its patches, creases and curves, for B-spline
         export (classical route only).
     curve_vertices : list of (k_c,) int64 or None

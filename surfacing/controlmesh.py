@@ -49,7 +49,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from .coons import coons_eval, coons_grid
-from curvenet.core.geometry import resample_polyline
+from curvenet.core.geometry import arc_length, resample_polyline
 from curvenet.core.tolerances import DIVISION_GUARD
 from .sides import DEFAULT_STRAIGHT_ANGLE, group_sides
 
@@ -115,7 +115,7 @@ def curve_pieces(curves: list, closed: np.ndarray) -> np.ndarray:
     -------
     (C,) int64
     """
-    lengths = np.array([np.linalg.norm(np.diff(c, axis=0), axis=1).sum() for c in curves])
+    lengths = np.array([arc_length(c) for c in curves])
     med = float(np.median(lengths)) if len(lengths) else 1.0
     turn = np.array([_turn_pieces(np.asarray(c, dtype=np.float64)) for c in curves])
     # a curve exactly PIECE_LENGTH medians long (rounding noise aside) stays one piece

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from curvenet.core.geometry import arc_length, cumulative_length
 from curvenet.core.tolerances import DIVISION_GUARD, DUPLICATE_POINT_REL
 
 __all__ = ["fit_cubic_curve"]
@@ -40,13 +41,13 @@ def fit_cubic_curve(points: np.ndarray, n_out: int, smoothing: float = 0.0) -> n
     if n_out < 2:
         raise ValueError(f"n_out: expected >= 2, got {n_out}")
     d = np.linalg.norm(np.diff(P, axis=0), axis=1)
-    keep = np.concatenate([[True], d > DUPLICATE_POINT_REL * max(d.sum(), DIVISION_GUARD)])
+    keep = np.concatenate([[True], d > DUPLICATE_POINT_REL * max(arc_length(P), DIVISION_GUARD)])
     P = P[keep]
     if len(P) < 4:
         t = np.linspace(0, 1, n_out)[:, None]
         return (1 - t) * P[0] + t * P[-1] if len(P) == 2 else np.asarray(
             [P[min(int(round(x * (len(P) - 1))), len(P) - 1)] for x in t[:, 0]])
-    u = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(P, axis=0), axis=1))])
+    u = cumulative_length(P)
     u /= u[-1]
     diag = float(np.linalg.norm(P.max(0) - P.min(0)))
     spl, _ = make_splprep(P.T, u=u, k=3, s=smoothing * len(P) * diag ** 2)

@@ -24,10 +24,12 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
-from .catmull_clark import subdivision_step
+from .levels import Level, extended_poles_many, local_samples, subdivide_grids, submesh
+from .splines import (BSplinePiece, basis, clamp_uniform, evaluate, project, span_points,
+                      uniform_knots)
 
-__all__ = ["DEFAULT_GRADE", "MAX_GRADE", "CornerChains", "corner_chains", "span_points",
-           "graded_breaks", "fit_graded", "submesh"]
+__all__ = ["DEFAULT_GRADE", "MAX_GRADE", "CornerChains", "corner_chains", "graded_breaks",
+           "fit_graded"]
 
 #: Breakpoints ``i +- 2^-k`` for ``k = 1 .. DEFAULT_GRADE`` around each irregular vertex.
 DEFAULT_GRADE = 5
@@ -81,24 +83,12 @@ class CornerChains:
         return out
 
 
-def span_points(P: np.ndarray, s: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Uniform bicubic B-spline spans ``P (n, 4, 4, 3)`` at ``s, t (n,)`` in ``[0, 1]``."""
-    return np.einsum("na,nb,nabc->nc", _uniform_weights(s), _uniform_weights(t), P)
-
-
-def _uniform_weights(t: np.ndarray) -> np.ndarray:
-    """Uniform cubic B-spline weights ``(n, 4)`` at ``t (n,)`` in ``[0, 1]``."""
-    t2, t3 = t * t, t * t * t
-    return np.stack([(1 - t) ** 3, 3 * t3 - 6 * t2 + 4, -3 * t3 + 3 * t2 + 3 * t + 1, t3],
-                    axis=1) / 6.0
-
-
-def corner_chains(lv, spans: np.ndarray, grade: int, sample_levels: int) -> CornerChains:
+def corner_chains(lv: Level, spans: np.ndarray, grade: int, sample_levels: int) -> CornerChains:
     """Follow each span's irregular vertex ``grade`` subdivision steps down.
 
     Parameters
     ----------
-    lv : bspline._Level
+    lv : Level
         The level the spans live on.
     spans : (k, 2, 2) int64
         Vertex ids of spans of ``lv`` with the irregular vertex at ``[0, 0]``.
@@ -110,39 +100,16 @@ def corner_chains(lv, spans: np.ndarray, grade: int, sample_levels: int) -> Corn
     -------
     CornerChains
     """
-    from .bspline import _diag_lookup, _extended_many, _Level, _local_samples, refine_grid
     grids = np.asarray(spans, np.int64)
     rings = []
     for _ in range(grade):
         V, Q, se, cr, grids = submesh(lv, grids)
-        st = subdivision_step(Q, len(V), se, cr)
-        find = _diag_lookup(Q, len(V))
-        H = [refine_grid(g, Q, st.topo, find) for g in grids]
-        lv = _Level(st.S @ V, st.quads, st.sharp_edges, st.corners)
-        rings.append(_extended_many(lv, np.stack(H))[0])
+        V, Q, se, cr, H = subdivide_grids(V, Q, se, cr, list(grids), 1)
+        lv = Level(V, Q, se, cr)
+        rings.append(extended_poles_many(lv, np.stack(H))[0])
         grids = np.stack([h[:2, :2] for h in H])
     rings = np.stack(rings) if rings else np.zeros((0, len(grids), 5, 5, 3))
-    return CornerChains(rings, _local_samples(lv, list(grids), sample_levels))
-
-
-def submesh(lv, grids: np.ndarray):
-    """The faces of ``lv`` around the vertices ``grids (k, ...)``, renumbered.
-
-    Returns
-    -------
-    vertices (n', 3), quads (f', 4), sharp_edges (s', 2), corners (n',), grids
-        The grids in the new numbering. Subdivision of this submesh is exact on
-        the faces whose one-ring it contains (its own border is sharp).
-    """
-    near = np.zeros(lv.n, bool)
-    near[np.asarray(grids).ravel()] = True
-    Q = lv.Q[near[lv.Q].any(axis=1)]
-    used, Qc = np.unique(Q, return_inverse=True)
-    lut = np.full(lv.n, -1, np.int64)
-    lut[used] = np.arange(len(used))
-    se = lut[np.asarray(lv.sharp_edges, np.int64).reshape(-1, 2)]
-    return (lv.V[used], Qc.reshape(Q.shape), se[(se >= 0).all(axis=1)], lv.corners[used],
-            lut[grids])
+    return CornerChains(rings, local_samples(lv, list(grids), sample_levels))
 
 
 def graded_breaks(m: int, vertices, grade: int) -> np.ndarray:
@@ -199,7 +166,6 @@ def fit_graded(E, off, centres, exact, *, grade: int, r: int, tol: float):
     deviation : float
         Largest error over all measured points (model units).
     """
-    from .bspline import BSplinePiece, _basis, clamp_uniform, evaluate, uniform_knots
     M, N = off.shape[0] - 1, off.shape[1] - 1
     bad = off[:-1, :-1] | off[1:, :-1] | off[:-1, 1:] | off[1:, 1:]
     bu = graded_breaks(M, centres[:, 0], grade)
@@ -230,8 +196,8 @@ def fit_graded(E, off, centres, exact, *, grade: int, r: int, tol: float):
     S[irr] = exact(u[irr], v[irr])
     # least squares for the free poles on every other sample
     fit = (su[iu] % 2 == 0) & (sv[iv] % 2 == 0)
-    cu, wu = _basis(u[fit], tu, 0)
-    cv, wv = _basis(v[fit], tv, 0)
+    cu, wu = basis(u[fit], tu, 0)
+    cv, wv = basis(v[fit], tv, 0)
     nv = P.shape[1]
     cols = (cu[:, :, None] * nv + cv[:, None, :]).reshape(len(cu), 16)
     vals = (wu[:, :, None] * wv[:, None, :]).reshape(len(cu), 16)
@@ -261,7 +227,6 @@ def _distances(pc, S: np.ndarray, u: np.ndarray, v: np.ndarray, tol: float) -> n
     (Gauss-Newton projection) from the largest down, until the rest cannot exceed
     the largest distance; below that, the distance at equal parameters (an upper
     bound)."""
-    from .bspline import evaluate, project
     err = np.linalg.norm(evaluate(pc, u, v) - S, axis=1)
     cand = np.flatnonzero(err > tol)
     cand = cand[np.argsort(-err[cand])]

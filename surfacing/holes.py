@@ -21,6 +21,7 @@ import numpy as np
 
 from curvenet.core.geometry import fit_plane
 
+from .api import DEFAULT_EDGE_LENGTH, DEFAULT_MAX_FACES, PatchMeshResult, surface_loops
 from .flat import FLAT_TOL, flat_planes, flatten_planar, loop_points, mesh_flat
 
 __all__ = ["split_holed", "split_boundaries", "surface_boundaries", "UnsplittableFace"]
@@ -264,8 +265,6 @@ def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: f
         in-plane) and ``unsplit_holes``; ``curves`` (when asked for) holds the input
         curves only.
     """
-    from . import surface_loops     # the package's, so a patched one is the one called
-    from .api import DEFAULT_EDGE_LENGTH, DEFAULT_MAX_FACES, PatchMeshResult
     n = len(curves)
     flat, normals, offsets = flat_planes(curves, boundaries, flat_tol)
     outer_only = [b[:1] if f else b for b, f in zip(boundaries, flat)]

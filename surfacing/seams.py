@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .bspline import EXACT_TOL, BSplinePiece, ControlNet, evaluate, piece_grids, project
+from .levels import ControlNet, piece_grids
+from .splines import EXACT_TOL, BSplinePiece, evaluate, project
 
 __all__ = ["border_samples", "seam_report"]
 

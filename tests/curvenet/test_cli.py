@@ -141,7 +141,7 @@ def test_neural_flags_reach_the_neural_fit(tmp_path, box_obj, monkeypatch, flag,
 
 
 @pytest.mark.parametrize("value,match", [("w_smooth", "NAME=VALUE"), ("bogus=1", "unknown"),
-                                         ("res=big", "int"), ("splat_volume=maybe", "true")])
+                                         ("res=big", "int"), ("lr=fast", "float")])
 def test_bad_neural_setting_is_one_clear_error(tmp_path, box_obj, capsys, value, match):
     with pytest.raises(SystemExit) as exc:
         main(["surface", str(box_obj), "-o", str(tmp_path / "m.obj"), "--neural-set", value])

@@ -8,9 +8,13 @@ marked ``slow`` (the CI keeps the tiny end-to-end runs).
 import numpy as np
 import pytest
 
-from curvenet.neural import flow
+from curvenet.neural import flow, flowfit
 from curvenet.neural.flow import fit_flow_surface
+from curvenet.neural.flowfit import FlowFit
+from curvenet.neural.frame import Frame
 from curvenet.neural.poisson import stroke_strip
+from curvenet.neural.presets import get_config
+from curvenet.neural.sampling import StrokeSampler, sample_surface_cells
 
 from ._metrics import fscore
 
@@ -53,7 +57,7 @@ def test_deterministic_on_cpu():
 
 def test_keyboard_interrupt_returns_surface_so_far(monkeypatch):
     calls = {"n": 0}
-    real = flow.sample_surface_cells
+    real = flowfit.sample_surface_cells
 
     def interrupting(*args, **kwargs):
         calls["n"] += 1
@@ -61,16 +65,15 @@ def test_keyboard_interrupt_returns_surface_so_far(monkeypatch):
             raise KeyboardInterrupt
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(flow, "sample_surface_cells", interrupting)
+    monkeypatch.setattr(flowfit, "sample_surface_cells", interrupting)
     r = fit_flow_surface(_circles(), progress=False, **TINY)
     assert r.report["interrupted"] is True
     assert r.report["steps"]["full"] == 2
     assert r.f_grid.shape == (32, 32, 32)
 
 
-def test_poisson_every_and_marching_cubes_sampler_run():
-    r = fit_flow_surface(_circles(), progress=False, poisson_every=2,
-                         surface_sampler="marching_cubes", **TINY)
+def test_poisson_every_runs():
+    r = fit_flow_surface(_circles(), progress=False, poisson_every=2, **TINY)
     assert len(r.history["full"]["total"]) == 4
     assert np.isfinite(r.history["full"]["total"]).all()
 
@@ -98,13 +101,12 @@ def test_refine_prefit_reproduces_the_init_mesh():
 
 def test_polish_keeps_the_surface_of_the_field():
     # g prefitted to sigma * grad SDF of the unit sphere, no flow step: f re-integrated from
-    # 16 times the samples of a step (strokes and f's zero set), low-passed by one cell, must
-    # still be that sphere, the one the stroke circles lie on
+    # 16 times the samples of a step (strokes and f's zero set) must still be that sphere,
+    # the one the stroke circles lie on
     import trimesh
     m = trimesh.creation.icosphere(3, radius=1.0)
     r = fit_flow_surface(_circles(), progress=False, init_mesh=(m.vertices, m.faces),
-                         quality="draft", res=48, prefit_steps=150, steps=0, polish=16,
-                         polish_smooth_cells=1.0)
+                         quality="draft", res=48, prefit_steps=150, steps=0, polish=16)
     radius = np.linalg.norm(r.vertices, axis=1)
     assert abs(radius.mean() - 1.0) < 0.02 and radius.std() < 0.01, (radius.mean(), radius.std())
 
@@ -112,11 +114,11 @@ def test_polish_keeps_the_surface_of_the_field():
 def test_average_from_averages_the_last_steps_and_leaves_training_alone():
     # the running mean starts at step int(average_from * steps) of the full stage; the
     # steps themselves (losses, f) are those of a fit without it
-    from curvenet.neural.training import train
+    from curvenet.neural.training import torch_device, train
     runs, fields = {}, []
     for average_from in (0.5, 1.0):
-        cfg = flow.get_config("draft", **TINY, polish=2, average_from=average_from)
-        fit = flow._FlowFit(_circles(), cfg, flow.torch_device("cpu"), 0, None)
+        cfg = get_config("draft", **TINY, polish=2, average_from=average_from)
+        fit = FlowFit(_circles(), cfg, torch_device("cpu"), 0, None)
         record = fit._record
 
         def keep_f(stage, k, row, fit=fit, record=record):
@@ -146,11 +148,10 @@ def _averaged_sphere_fit():
     import torch
     import trimesh
 
-    from curvenet.neural.presets import get_config
     from curvenet.neural.training import train
     m = trimesh.creation.icosphere(3, radius=1.0)
-    cfg = get_config("draft", res=48, prefit_steps=150, polish=16, polish_smooth_cells=1.0)
-    fit = flow._FlowFit(_circles(), cfg, torch.device("cpu"), 0, (m.vertices, m.faces))
+    cfg = get_config("draft", res=48, prefit_steps=150, polish=16)
+    fit = FlowFit(_circles(), cfg, torch.device("cpu"), 0, (m.vertices, m.faces))
     train(fit.net.parameters(), fit.stages()[:1], lr=cfg.lr)
     fit.f = _sphere_f(fit.frame, 48, 1.0)
     fit._average()
@@ -198,7 +199,7 @@ def test_polish_is_kept_only_when_it_holds_the_strokes(last, polished, kept):
     # radius 0.8 is off them and the last step's surface is returned; the other way round
     # (and on a tie) the polished one
     class Fit:
-        frame = flow.Frame.from_points(np.vstack(_circles()), 0.2)
+        frame = Frame.from_points(np.vstack(_circles()), 0.2)
 
         def polish(self, f):
             return _sphere_f(self.frame, 48, polished)
@@ -321,13 +322,13 @@ def _integrate_radial_field(strip, res=64, iters=12, n=1500, seed=0):
     R, c = 0.3, 0.5
     strokes = [c + R * s for s in _circles(200)]
     gen = torch.Generator().manual_seed(seed)
-    sampler = flow.StrokeSampler(strokes, "cpu", torch.float64)
+    sampler = StrokeSampler(strokes, "cpu", torch.float64)
     solver = PoissonSolver(res, dtype=torch.float64)
     x = (torch.arange(res, dtype=torch.float64) + 0.5) / res
     f = (torch.stack(torch.meshgrid(x, x, x, indexing="ij"), -1) - c).norm(dim=-1) - R
     for _ in range(iters):
         x_s, _ = sampler.sample(n, gen)
-        x_u = flow.sample_surface_cells(f, n, gen)
+        x_u = sample_surface_cells(f, n, gen)
         mass = None
         if strip:
             keep, mass = stroke_strip(x_s, x_u, 1.0 / res)
@@ -337,7 +338,7 @@ def _integrate_radial_field(strip, res=64, iters=12, n=1500, seed=0):
         f = solver.solve(grid)
         f, _ = normalize_scale_shift(f, interpolate(f, x_s))
         f = f if f[0, 0, 0] > 0 else -f
-    s = flow.sample_surface_cells(f, 20000, gen)
+    s = sample_surface_cells(f, 20000, gen)
     return float(((s - c).norm(dim=-1) - R).mean()) * res
 
 
@@ -348,13 +349,13 @@ def test_stroke_strip_keeps_a_sphere_between_its_strokes():
     assert abs(_integrate_radial_field(strip=True)) < 0.06
 
 
-def test_stroke_strip_in_the_fit_keeps_the_sphere():
+def test_polish_with_the_stroke_strip_keeps_the_sphere():
     # g prefitted to the unit sphere, two normalised flow steps and the polish with the strip:
     # the surface stays the sphere the stroke circles lie on
     import trimesh
     m = trimesh.creation.icosphere(3, radius=1.0)
     r = fit_flow_surface(_circles(), progress=False, init_mesh=(m.vertices, m.faces),
                          quality="draft", res=48, prefit_steps=150, steps=2, normalize_from=0.0,
-                         stroke_strip=1.0, polish=8, polish_strip=1.0)
+                         polish=8, polish_strip=1.0)
     radius = np.linalg.norm(r.vertices, axis=1)
     assert abs(radius.mean() - 1.0) < 0.02 and radius.std() < 0.015, (radius.mean(), radius.std())

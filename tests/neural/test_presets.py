@@ -12,7 +12,6 @@ def test_paper_preset_matches_published_settings():
     assert (c.init_steps, c.steps) == (200, 800)
     assert (c.w_align, c.w_smooth, c.w_data, c.w_eik, c.w_curl) == (1.0, 0.01, 30.0, 7.0, 7.0)
     assert (c.sigma, c.padding) == (0.5, 0.2)
-    assert c.align_penalty == "square"                 # Eq. 4
 
 
 def test_overrides_and_presets():
@@ -23,10 +22,10 @@ def test_overrides_and_presets():
 
 @pytest.mark.parametrize("kw,match", [({"res": 4}, "res"), ({"steps": -1}, "steps"),
                                       ({"bogus": 1}, "unknown"), ({"lr": 0}, "lr"),
-                                      ({"surface_sampler": "x"}, "surface_sampler"),
+                                      ({"boundary": "x"}, "boundary"),
                                       ({"normalize_from": 2.0}, "normalize_from"),
                                       ({"average_from": -0.1}, "average_from"),
-                                      ({"align_penalty": "cube"}, "align_penalty"),
+                                      ({"dtype": "float16"}, "dtype"),
                                       ({"polish": 1.5}, "polish")])
 def test_bad_overrides(kw, match):
     with pytest.raises(ValueError, match=match):

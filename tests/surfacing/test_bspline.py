@@ -2,19 +2,11 @@
 extraordinary vertices (oracles: the limit points of further subdivision, scipy's bisplev)."""
 
 import numpy as np
-from scipy.interpolate import bisplev
 from scipy.spatial import cKDTree
 
 from curvenet.surfacing import subdivide
-from curvenet.surfacing.bspline import (BSplinePiece, ControlNet, evaluate, extract_bsplines,
-                                        piece_grids, project)
+from curvenet.surfacing.bspline import ControlNet, evaluate, extract_bsplines, project
 from curvenet.surfacing.limit import limit_matrix
-
-
-def _grid(p, q, off=0):
-    G = off + np.arange((p + 1) * (q + 1)).reshape(p + 1, q + 1)
-    return np.stack([G[:-1, :-1].ravel(), G[1:, :-1].ravel(), G[1:, 1:].ravel(),
-                     G[:-1, 1:].ravel()], 1)
 
 
 def _torus_net(nu=8, nv=6, pieces=2):
@@ -62,19 +54,6 @@ def _piece_points(bset, r):
     return np.concatenate(pts)
 
 
-def test_piece_grids_recovers_row_major_grids():
-    Q = np.concatenate([_grid(2, 3), _grid(1, 1, 100)])
-    fp = np.r_[np.zeros(6, int), np.ones(1, int)]
-    g = piece_grids(Q, fp)
-    assert [p for p, _ in g] == [0, 1]
-    assert g[0][1].shape == (3, 4) and g[1][1].shape == (2, 2)
-    # another face order still covers every quad exactly once (as smaller grids)
-    g = piece_grids(Q[[1, 0, 2, 3, 4, 5, 6]], fp)
-    got = np.concatenate([np.stack([G[:-1, :-1].ravel(), G[1:, :-1].ravel(), G[1:, 1:].ravel(),
-                                    G[:-1, 1:].ravel()], 1) for _, G in g])
-    assert sorted(map(tuple, got)) == sorted(map(tuple, Q))
-
-
 def test_regular_torus_is_exact_everywhere():
     net = _torus_net()
     level = 1
@@ -91,18 +70,6 @@ def test_regular_torus_is_exact_everywhere():
     assert d2.max() < 1e-12 * net.diagonal
     for s in bset.seams:
         assert s["gap"] < 1e-13 and s["angle"] < 1e-5 and not s["crease"]
-
-
-def test_evaluate_matches_scipy_bisplev():
-    bset = extract_bsplines(_torus_net(), 1)
-    pc: BSplinePiece = bset.pieces[0]
-    u = np.linspace(0, pc.knots_u[-1], 7)
-    v = np.linspace(0, pc.knots_v[-1], 5)
-    U, Vv = np.meshgrid(u, v, indexing="ij")
-    ours = evaluate(pc, U.ravel(), Vv.ravel()).reshape(7, 5, 3)
-    for k in range(3):
-        ref = bisplev(u, v, [pc.knots_u, pc.knots_v, pc.poles[:, :, k].ravel(), 3, 3])
-        assert np.abs(ref - ours[:, :, k]).max() < 1e-12
 
 
 def test_clamped_borders_are_shared_poles():

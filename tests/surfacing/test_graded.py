@@ -7,7 +7,9 @@ from scipy.spatial import cKDTree
 
 from curvenet.surfacing import bspline
 from curvenet.surfacing.bspline import ControlNet, evaluate, extract_bsplines, project
-from curvenet.surfacing.graded import graded_breaks
+from curvenet.surfacing.graded import corner_chains, graded_breaks
+from curvenet.surfacing.levels import extended_poles, subdivide_net
+from curvenet.surfacing.splines import tensor_grid, uniform_design
 
 
 def _cube_net():
@@ -32,20 +34,19 @@ def test_exact_limit_around_irregular_corners_matches_deep_subdivision():
     points of a globally subdivided mesh, at every dyadic parameter of every site."""
     net = _cube_net()
     level, grade, sl, d = 1, 2, 2, 4
-    _, lv, grids, limit = bspline._level(net, level)
-    _, _, fine, fine_limit = bspline._level(net, level + d)
+    _, lv, grids, limit = subdivide_net(net, level)
+    _, _, fine, fine_limit = subdivide_net(net, level + d)
     offs = []
     for G in grids:
         M, N = G.shape[0] - 1, G.shape[1] - 1
-        E = bspline._extended(lv, G)[0]
-        at = bspline._tensor(bspline._design(np.arange(M + 1), M), E,
-                             bspline._design(np.arange(N + 1), N))
+        E = extended_poles(lv, G)[0]
+        at = tensor_grid(uniform_design(np.arange(M + 1), M), E,
+                         uniform_design(np.arange(N + 1), N))
         offs.append(np.linalg.norm(at - limit[G], axis=2) > 1e-10)
     sites, spans, own = bspline._sites(lv, grids, offs, limit, 1e-10)
     assert (sites[:, 3] >= 0).all()              # every irregular span at a cube vertex
     corner_ids = [grids[p][i, j] for p, i, j in sites[:, [0, 3, 4]]]
     assert set(corner_ids) == set(range(8))     # (vertex ids survive subdivision)
-    from curvenet.surfacing.graded import corner_chains
     chains = corner_chains(lv, np.stack(spans), grade, sl)
     worst = 0.0
     for pid, G in enumerate(grids):
@@ -66,7 +67,7 @@ def test_exact_limit_around_irregular_corners_matches_deep_subdivision():
 @pytest.mark.parametrize("level", [1, 2])
 def test_grading_shrinks_the_deviation_and_measures_it(level):
     net = _cube_net()
-    _, _, fine, fine_limit = bspline._level(net, level + 4)
+    _, _, fine, fine_limit = subdivide_net(net, level + 4)
     true = {}
     for grade in (0, 4):
         bset = extract_bsplines(net, level, grade=grade)
@@ -94,7 +95,7 @@ def test_graded_pieces_stay_watertight_at_seams():
     for s in bset.seams:
         assert s["gap"] <= 2 * dev + 1e-12
     # dense points of all pieces cover the whole limit surface
-    _, _, fine, fine_limit = bspline._level(net, 5)
+    _, _, fine, fine_limit = subdivide_net(net, 5)
     P = []
     for pc in bset.pieces:
         u, v = np.meshgrid(np.linspace(0, pc.knots_u[-1], 33),
