@@ -1,7 +1,7 @@
 """Why the flow-aligned fit misses flat faces bounded by crease strokes: three oracles.
 
 ``python benchmarks/bench_flow_limits.py caps`` -- the smoothness energy of Zhang et al. 2025
-(Eq. 5, the covariant total variation of II, :func:`neural.geometry.covariant_tv`) of a
+(Eq. 5, the covariant total variation of II, :func:`neural.level_sets.covariant_tv`) of a
 capped cylinder (radius 0.5, height 1, the rough ``capped_cylinder`` sketch's shape) whose
 top cap is a spherical dome of curvature k (k = 0: the flat cap of the true shape; k = 2: a
 hemisphere, tangent to the side). The solid is the smooth maximum (log-sum-exp, width tau)
@@ -21,7 +21,7 @@ set for draft and denser surface sample counts, the rasterised g raw or normalis
 stroke and surface samples. This is the best any g can do at those settings.
 
 ``python benchmarks/bench_flow_limits.py refit`` -- the crease refit of
-:func:`neural.creases.crease_refine`, with and without the SharpNet strips, applied to the
+:func:`neural.crease_refit.crease_refine`, with and without the SharpNet strips, applied to the
 box that the draft Poisson reconstruction makes from the exact gradient (the best input any
 draft flow fit could hand it): normal error and median dihedral angle across the crease
 strokes (as ``bench_sharpnet.py box``).
@@ -117,7 +117,7 @@ def cap_energy(k: float, tau: float, *, n: int = 600_000, eps: float = 0.004, se
     import torch
     from torch.func import jacfwd, vmap
 
-    from curvenet.neural.geometry import covariant_tv
+    from curvenet.neural.level_sets import covariant_tv
 
     F = _capped_solid(k, tau)
     g_f = jacfwd(F)
@@ -240,7 +240,7 @@ def bench_refit(args) -> None:
 
     from bench_sharpnet import box_dihedrals
     from curvenet.evaluate import evaluate_mesh
-    from curvenet.neural.creases import crease_refine
+    from curvenet.neural.crease_refit import crease_refine
     from curvenet.neural.extract import keep_supported_components
 
     torch.set_num_threads(args.threads)

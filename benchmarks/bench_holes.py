@@ -30,7 +30,7 @@ from curvenet.core.errors import CurvenetError
 from curvenet.evaluate import evaluate_mesh, stroke_distance
 from curvenet.cycles.loops import orient_boundaries
 from curvenet.pipeline import surface
-from curvenet.surfacing.holes import surface_boundaries
+from curvenet.surfacing.sectors import surface_boundaries
 
 DATA = Path(os.environ.get("CURVENET_DATA",
                            Path(__file__).resolve().parents[2] / "shared" / "data"))

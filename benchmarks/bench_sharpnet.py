@@ -9,7 +9,7 @@ in a fresh subprocess.
 [--steps N]`` -- the
 box sketch with its 12 edges labelled ``crease`` (``curvenet.datasets.shapes.box``, roughened with
 ``curvenet.datasets.redraw.rough_sketch`` unless ``--clean``): the crease refinement
-(:func:`neural.creases.crease_refine`) with the feature strips against the same fit without
+(:func:`neural.crease_refit.crease_refine`) with the feature strips against the same fit without
 them (same network, data and steps), normal error against the true box
 (``curvenet.evaluate``: mean angle between normals at closest points, both directions) and
 the dihedral angles across the crease strokes; writes ``benchmarks/results/box_creases.png``.
@@ -228,7 +228,7 @@ def bench_box(args) -> None:
     from curvenet.evaluate import evaluate_mesh
     from curvenet.datasets.redraw import rough_sketch
     from curvenet.datasets.shapes import box
-    from curvenet.neural.creases import crease_refine
+    from curvenet.neural.crease_refit import crease_refine
 
     torch.set_num_threads(args.threads)
     shape = box()

@@ -490,7 +490,7 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
         Options of the classical surfacer (:func:`surfacing.surface_loops` keywords) and
         of the neural one (:class:`neural.presets.FlowConfig` fields).
     crease_options : dict, optional
-        Settings of the neural crease refit (:class:`neural.creases.CreaseConfig`).
+        Settings of the neural crease refit (:class:`neural.crease_refit.CreaseConfig`).
     points : {"auto", True, False}
         Reading of unordered point samples (see :func:`load_source`); the reading taken
         is in ``diagnostics["reading"]``.

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 from curvenet.core.tolerances import NORM_EPS
 
-from .geometry import alignment_cos4, covariant_tv, curl
+from .level_sets import alignment_cos4, covariant_tv, curl
 
 __all__ = ["alignment_loss", "smoothness_loss", "data_loss", "eikonal_loss", "curl_loss",
            "normal_loss"]

@@ -2,7 +2,7 @@
 
 A :class:`FlowConfig` holds the settings of the flow-aligned surfacing (Zhang, Wang,
 Bessmeltsev 2025; :func:`neural.flow.fit_flow_surface`), a :class:`CreaseConfig` those
-of the crease refit (Niu et al. 2025; :func:`neural.creases.crease_refine`). Each has
+of the crease refit (Niu et al. 2025; :func:`neural.crease_refit.crease_refine`). Each has
 three presets, ``draft``, ``default`` and ``paper``; a keyword overrides one field of
 the chosen preset (``fit_flow_surface(..., res=96)``).
 
@@ -293,11 +293,11 @@ def parse_setting(text: str) -> tuple[str, object]:
 
 
 # ---------------------------------------------------------------------------------------------
-# crease refit (neural.creases.crease_refine)
+# crease refit (neural.crease_refit.crease_refine)
 # ---------------------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class CreaseConfig:
-    """Settings of :func:`neural.creases.crease_refine` (lengths in its unit frame:
+    """Settings of :func:`neural.crease_refit.crease_refine` (lengths in its unit frame:
     the data in [-0.8, 0.8]^3).
 
     Attributes
@@ -331,7 +331,7 @@ class CreaseConfig:
         Loss weights of Eq. 9 (``w_nor`` as in Eq. 10).
     w_sdf : float
         Weight of the value term on near-surface samples (not in the paper; see
-        :func:`neural.creases.crease_refine`).
+        :func:`neural.crease_refit.crease_refine`).
     ext_alpha : float
         alpha of ``L_ext = exp(-alpha |Phi|)`` (not given in the paper; SIREN uses 100).
     near_sigma : float

@@ -3,7 +3,7 @@
 A crease stroke becomes a feature set M: a strip surface along the stroke that
 approximates the medial surface near the sharp edge. A SharpNet SDF with these strips
 as features is C0 exactly on the strips, so its zero set can have a true crease where
-a strip crosses it (:func:`neural.creases.crease_refine`).
+a strip crosses it (:func:`neural.crease_refit.crease_refine`).
 
 - :func:`guide_directions` -- per-vertex guiding directions from per-edge ones (the
   Appendix A energy with a squared relaxation, solved in closed form);

@@ -1,6 +1,6 @@
 """The one optimisation loop of the neural fits: Adam over stages of step functions.
 
-Each fit (:func:`neural.flow.fit_flow_surface`, :func:`neural.creases.crease_refine`)
+Each fit (:func:`neural.flow.fit_flow_surface`, :func:`neural.crease_refit.crease_refine`)
 seeds its random streams with :func:`seeded`, checks its device with
 :func:`torch_device`, and hands :func:`train` a list of :class:`Stage` objects whose
 step functions build one loss each. The loop owns what is common: the Adam optimiser

@@ -18,7 +18,7 @@ from curvenet.core.errors import InvalidParameterError
 from .levels import ControlNet
 from .catmull_clark import edge_index, subdivision_step
 from .controlmesh import build_control_mesh
-from .creases import DEFAULT_CREASE_ANGLE, sharp_structure
+from .sharp import DEFAULT_CREASE_ANGLE, sharp_structure
 from .curveupdate import fit_cubic_curve
 from .fit import (FAIRNESS, LAMBDA, VSPRING_STEP, fairness_matrix, fit_iterative, fit_lsq,
                   variation_matrix)

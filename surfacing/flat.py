@@ -42,7 +42,7 @@ def flat_planes(curves, boundaries, tol: float = FLAT_TOL):
     Parameters
     ----------
     curves, boundaries
-        As for :func:`surfacing.holes.surface_boundaries`.
+        As for :func:`surfacing.sectors.surface_boundaries`.
     tol : float
         Flatness of a boundary, fraction of the curves' bounding-box diagonal.
 

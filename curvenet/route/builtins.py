@@ -47,7 +47,7 @@ def _boundaries(inp: SurfaceInput) -> list:
 
 
 def _catmull_clark(inp: SurfaceInput, options: dict) -> MeshResult:
-    from ..surfacing.holes import surface_boundaries
+    from ..surfacing.sectors import surface_boundaries
     return surface_boundaries(inp.curves, _boundaries(inp), crease_curves=inp.crease_curves,
                               crease_angle=inp.settings.crease_angle,
                               **_loops_kwargs(options, inp.settings))
@@ -66,14 +66,14 @@ def _check_soapfilm(options: dict, settings: SurfaceSettings) -> None:
 
 def _soapfilm(inp: SurfaceInput, options: dict) -> MeshResult:
     from ..surfacing import soapfilm_loops
-    from ..surfacing.holes import split_boundaries
+    from ..surfacing.sectors import split_boundaries
     curves, loops, _, _ = split_boundaries(inp.curves, _boundaries(inp))
     return soapfilm_loops(curves, loops, **options)
 
 
 def _check_neural(options: dict, settings: SurfaceSettings) -> None:
     """Flow settings (:class:`neural.presets.FlowConfig` fields) and, under ``"creases"``,
-    the crease refit's (:class:`neural.creases.CreaseConfig` fields)."""
+    the crease refit's (:class:`neural.crease_refit.CreaseConfig` fields)."""
     from ..neural.presets import get_config
     flow = dict(options)
     creases = flow.pop("creases", None)
@@ -82,7 +82,7 @@ def _check_neural(options: dict, settings: SurfaceSettings) -> None:
     except ValueError as err:
         raise InvalidParameterError(f"neural_options: {err}") from err
     if creases:
-        from ..neural.creases import crease_config
+        from ..neural.crease_refit import crease_config
         try:
             crease_config(settings.quality, creases)
         except ValueError as err:
@@ -91,7 +91,7 @@ def _check_neural(options: dict, settings: SurfaceSettings) -> None:
 
 def _neural(inp: SurfaceInput, options: dict) -> MeshResult:
     """Flow-aligned implicit fit, then the crease refit when some strokes are creases."""
-    from ..neural import creases, flow
+    from ..neural import crease_refit, flow
     s = inp.settings
     _check_device(s.device)
     flow_options = dict(options)
@@ -101,7 +101,7 @@ def _neural(inp: SurfaceInput, options: dict) -> MeshResult:
                                 anchors=inp.anchors, progress=s.progress, **flow_options)
     verts, faces, report = res.vertices, res.faces, dict(res.report)
     if "crease" in inp.labels and not report.get("interrupted"):
-        cres = creases.crease_refine(verts, faces, inp.strokes, inp.labels, quality=s.quality,
+        cres = crease_refit.crease_refine(verts, faces, inp.strokes, inp.labels, quality=s.quality,
                                      device=s.device, seed=s.seed, progress=s.progress,
                                      **crease_options)
         verts, faces = cres.vertices, cres.faces

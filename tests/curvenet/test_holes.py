@@ -179,7 +179,7 @@ def test_cad_classical_fscore(name):
 def test_cad_flat_faces_are_flat(name):
     """Every output vertex of a planar face lies in its plane to 1e-6 of the diagonal."""
     from curvenet.cycles.loops import orient_boundaries
-    from curvenet.surfacing.holes import surface_boundaries
+    from curvenet.surfacing.sectors import surface_boundaries
     s = shapes.CAD_SHAPES[name]()
     net = s.network
     ps = find_patches(net)
@@ -223,7 +223,7 @@ def test_plane_of_a_two_point_loop_is_a_complete_frame():
 
 def test_a_face_no_cut_can_split_is_surfaced_over_its_outer_loop(monkeypatch):
     # e.g. the VNS torus sketch: an equator disc with the inner equator as a hole
-    import curvenet.surfacing.holes as sh
+    import curvenet.surfacing.sectors as sh
 
     def refuse(*args, **kwargs):
         raise sh.UnsplittableFace("no set of straight cuts")

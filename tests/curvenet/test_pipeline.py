@@ -97,7 +97,7 @@ def test_bad_parameters_raise_curvenet_errors():
 def test_crease_options_reach_the_crease_refit(monkeypatch):
     import types
 
-    from curvenet.neural import creases as neural_creases
+    from curvenet.neural import crease_refit as neural_creases
     from curvenet.neural import flow as neural_flow
     box = shapes.box()
     ref = box.reference_mesh()

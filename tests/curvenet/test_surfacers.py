@@ -156,12 +156,12 @@ def test_bad_options_fail_before_any_work(monkeypatch, kwargs, match):
 
 
 def test_an_internal_value_error_stays_internal(monkeypatch, box_obj, capsys):
-    # the classical surfacer calls surface_loops through surfacing.holes.surface_boundaries
-    from curvenet.surfacing import holes
+    # the classical surfacer calls surface_loops through surfacing.sectors.surface_boundaries
+    from curvenet.surfacing import sectors
 
     def broken(curves, loops, **kw):
         raise ValueError("operands could not be broadcast together")  # a numpy bug, say
-    monkeypatch.setattr(holes, "surface_loops", broken)
+    monkeypatch.setattr(sectors, "surface_loops", broken)
     with pytest.raises(ValueError, match="broadcast") as exc:
         curvenet.surface(shapes.box().sketch(), method="classical")
     assert not isinstance(exc.value, curvenet.CurvenetError)

@@ -80,9 +80,9 @@ def test_rough_torus_default_on_cuda_has_genus_one():
 
 
 def test_crease_refine_on_cuda():
-    from curvenet.neural.creases import crease_refine
+    from curvenet.neural.crease_refit import crease_refine
 
-    from .test_creases import _box_edges, _box_mesh
+    from .test_crease_refit import _box_edges, _box_mesh
     v, f = _box_mesh()
     strokes = _box_edges()
     r = crease_refine(v, f, strokes, ["crease"] * 12, steps=30, res=32, progress=False,

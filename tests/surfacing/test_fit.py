@@ -4,7 +4,7 @@ import pytest
 from curvenet.datasets import shapes
 from curvenet.surfacing.catmull_clark import edge_topology
 from curvenet.surfacing.controlmesh import build_control_mesh
-from curvenet.surfacing.creases import sharp_structure
+from curvenet.surfacing.sharp import sharp_structure
 from curvenet.surfacing.fit import (fairness_matrix, fit_iterative, fit_lsq, variation_matrix,
                            vspring_displacement)
 from curvenet.surfacing.limit import limit_matrix, tangent_matrices

@@ -5,7 +5,7 @@ import pytest
 
 from curvenet.surfacing.api import surface_loops
 from curvenet.surfacing.flat import flat_planes, mesh_flat
-from curvenet.surfacing.holes import surface_boundaries
+from curvenet.surfacing.sectors import surface_boundaries
 
 # an L-shaped outline (area 4) with a square window (area 0.25) in its long leg
 L_OUTLINE = [(0, 0), (3, 0), (3, 1), (1, 1), (1, 2), (0, 2)]

@@ -4,7 +4,7 @@ import pytest
 from curvenet.datasets import shapes
 from curvenet.surfacing.catmull_clark import edge_index, subdivide, subdivision_step
 from curvenet.surfacing.controlmesh import build_control_mesh
-from curvenet.surfacing.creases import sharp_structure
+from curvenet.surfacing.sharp import sharp_structure
 from curvenet.surfacing.limit import limit_matrix, limit_normals, tangent_matrices
 
 from ._meshes import cube, grid

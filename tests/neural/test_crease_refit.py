@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from curvenet.neural.creases import crease_refine
+from curvenet.neural.crease_refit import crease_refine
 
 from ._box import box_edges, box_mesh
 

@@ -5,7 +5,7 @@ import math
 import pytest
 import torch
 
-from curvenet.neural.geometry import (alignment_cos4, covariant_tv, curl, directional_derivative_II,
+from curvenet.neural.level_sets import (alignment_cos4, covariant_tv, curl, directional_derivative_II,
                              principal_curvatures, second_fundamental_form, tangent_frame)
 from curvenet.core.tolerances import NORM_EPS
 from curvenet.neural.losses import alignment_loss, curl_loss, smoothness_loss
@@ -144,7 +144,7 @@ def _smoothness_autograd(net, x, eps=NORM_EPS):
 
     ``II`` is built from ``net.jet(x, order=1)`` and differentiated with respect to
     ``x`` by autograd (6 distinct components, ``create_graph``), then projected as in
-    :func:`neural.geometry.covariant_tv`.
+    :func:`neural.level_sets.covariant_tv`.
     """
     x = x.detach().requires_grad_(True)
     g, G = net.jet(x, order=1)

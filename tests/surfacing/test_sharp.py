@@ -3,7 +3,7 @@ import pytest
 
 from curvenet.datasets import shapes
 from curvenet.surfacing.controlmesh import build_control_mesh
-from curvenet.surfacing.creases import dihedral_angles, sharp_structure
+from curvenet.surfacing.sharp import dihedral_angles, sharp_structure
 
 
 def _cm(name):
