@@ -4,7 +4,8 @@ public clean networks (patch counts, holes, stroke distance, output size, time).
 Run ``CURVENET_DATA=/work/shared/data python benchmarks/bench_holes.py [--no-data]``.
 Prints two tables:
 
-1. every :data:`curvenet.datasets.shapes.CAD_SHAPES` network through ``surface(method="classical")``:
+1. every :data:`curvenet.datasets.shapes.CAD_SHAPES` network through
+   ``surface(method="classical")``:
    patches, holes, seconds, triangles, F-score at 0.01 against the true surface
    (30k samples), and the flatness of the flat faces (largest distance of an
    output vertex of a face whose boundary is planar to that plane, fraction of

@@ -23,9 +23,11 @@ from collections import deque
 import numpy as np
 
 from .gf2 import edge_mask
+from ..core.geometry import cumulative_length
 from ..core.tolerances import DIVISION_GUARD
 from ..core.errors import InvalidParameterError, NetworkError
 from .loops import cycle_to_loop, newell_normal
+from .search import horton_cycles, simple_cycles
 from ..model.network import CurveNetwork
 
 __all__ = ["Candidate", "CandidatePool", "SEPARATING_EPS", "TIE_BREAKS", "ENGINES",
@@ -388,8 +390,7 @@ class CandidatePool:
         t = np.zeros((self.n_edges, 2, 3))
         for i, e in enumerate(self.network.edges):
             c = e.curve
-            seg = np.linalg.norm(np.diff(c, axis=0), axis=1)
-            s = np.concatenate([[0.0], np.cumsum(seg)])
+            s = cumulative_length(c)
             if s[-1] <= 0:
                 continue
             d = _END_TANGENT_FRAC * s[-1]
@@ -511,50 +512,12 @@ class CandidatePool:
         return edges, verts
 
     def _raw_cycles_python(self, L: int):
-        out = []
-        adj = self.adj
-        work = self.work
-        budget = self.max_work
-        for s in range(self.n_vertices):
-            if not adj[s]:
-                continue
-            dist = self._dist_from(s)
-            # stack of (vertex, depth, edge path, vertex path)
-            for y, e in adj[s]:
-                if y < s:
-                    continue
-                if L == 2:
-                    if y == s:
-                        continue
-                    for y2, e2 in adj[y]:
-                        if y2 == s and e2 > e:
-                            out.append(((e, e2), (s, y)))
-                    continue
-                if y == s or dist.get(y, L + 1) + 1 > L:
-                    continue
-                stack = [(y, 1, (e,), (s, y))]
-                while stack:
-                    x, depth, ep, vp = stack.pop()
-                    work += 1
-                    if depth == L - 1:
-                        for z, ez in adj[x]:
-                            if z == s and ez > ep[0]:
-                                out.append((ep + (ez,), vp))
-                        continue
-                    for z, ez in adj[x]:
-                        if z <= s or z in vp:
-                            continue
-                        dz = dist.get(z)
-                        if dz is None or depth + 1 + dz > L:
-                            continue
-                        stack.append((z, depth + 1, ep + (ez,), vp + (z,)))
-                if work > budget:
-                    self.work = work
-                    self.work_bound_hit = True
-                    return None
-        self.work = work
-        return (np.array([o[0] for o in out], dtype=np.int64).reshape(-1, L),
-                np.array([o[1] for o in out], dtype=np.int64).reshape(-1, L))
+        found = simple_cycles(self.adj, L, self._dist_from, self.work, self.max_work)
+        self.work = found[2]
+        if found[0] is None:
+            self.work_bound_hit = True
+            return None
+        return found[0], found[1]
 
     def cycles_of_length(self, L: int):
         """Weighted candidates of length ``L``, or ``None`` when the work bound is hit.
@@ -583,43 +546,7 @@ class CandidatePool:
             :attr:`all_candidates` yet, by length; they are added to it.
         """
         seen = {frozenset(c.edges) for c in self._candidates}
-        by_len: dict = {}
-        for s in range(self.n_vertices):
-            if not self.adj[s]:
-                continue
-            par = {s: (-1, -1)}  # vertex -> (parent, edge)
-            branch = {s: -1}
-            q = deque([s])
-            while q:
-                x = q.popleft()
-                for y, e in self.adj[x]:
-                    if y not in par:
-                        par[y] = (x, e)
-                        branch[y] = y if x == s else branch[x]
-                        q.append(y)
-            tree_edges = {pe for _, pe in par.values()}
-            for x in par:
-                for y, e in self.adj[x]:
-                    if e in tree_edges or y < x:
-                        continue
-                    if x != s and y != s and branch[x] == branch[y]:
-                        continue
-                    edges, verts = [e], [x, y]
-                    for w in (x, y):
-                        while w != s:
-                            p, pe = par[w]
-                            edges.append(pe)
-                            if p != s:
-                                verts.append(p)
-                            w = p
-                    verts.append(s)
-                    fe = frozenset(edges)
-                    if len(fe) != len(edges) or len(fe) < min_length or fe in seen:
-                        continue
-                    if len(set(verts)) != len(edges):
-                        continue
-                    seen.add(fe)
-                    by_len.setdefault(len(edges), []).append((tuple(edges), tuple(set(verts))))
+        by_len = horton_cycles(self.adj, seen, min_length)
         out = []
         for L in sorted(by_len):
             out.extend(self.make_candidates(np.array([c[0] for c in by_len[L]]),

@@ -2,7 +2,7 @@
 
 Imported only when the search is deep enough to pay for importing numba; the
 compiled function is cached on disk (``cache=True``). Same search as
-``CandidatePool._raw_cycles_python``, which the tests compare it with.
+:func:`curvenet.cycles.search.simple_cycles`, which the tests compare it with.
 """
 
 from __future__ import annotations

@@ -90,7 +90,8 @@ class PatchSession:
     backend : {"galois", "bitset"}
         GF(2) solver for the suggestions.
     max_work : int
-        Enumeration budget for candidate cycles (see :class:`~curvenet.cycles.candidates.CandidatePool`).
+        Enumeration budget for candidate cycles (see
+        :class:`~curvenet.cycles.candidates.CandidatePool`).
 
     Notes
     -----

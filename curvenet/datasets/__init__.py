@@ -1,2 +1,3 @@
-"""Inputs whose truth is known: analytic shapes and their curve networks, CAD-like parts, redraw models of rough sketches."""
-
+"""Inputs whose truth is known: analytic shapes and their curve networks
+(:mod:`.shapes`), CAD-like parts (:mod:`.cadnet`), and redraw models that turn a
+network into a rough sketch (:mod:`.redraw`)."""

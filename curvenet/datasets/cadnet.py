@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.geometry import arc_length
 from ..cycles.loops import orient_boundaries
 from ..model.network import CurveNetwork
 from ..model.patchset import Patch
@@ -147,7 +148,7 @@ def _reversed(piece):
 def _dense(piece, h):
     """Points of a 3D piece at spacing about ``h`` (both ends)."""
     rough = piece(np.linspace(0, 1, 65))
-    length = np.linalg.norm(np.diff(rough, axis=0), axis=1).sum()
+    length = arc_length(rough)
     return piece(np.linspace(0, 1, max(2, int(np.ceil(length / h)) + 1)))
 
 

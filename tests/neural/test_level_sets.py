@@ -5,8 +5,9 @@ import math
 import pytest
 import torch
 
-from curvenet.neural.level_sets import (alignment_cos4, covariant_tv, curl, directional_derivative_II,
-                             principal_curvatures, second_fundamental_form, tangent_frame)
+from curvenet.neural.level_sets import (alignment_cos4, covariant_tv, curl,
+                                        directional_derivative_II, principal_curvatures,
+                                        second_fundamental_form, tangent_frame)
 from curvenet.core.tolerances import NORM_EPS
 from curvenet.neural.losses import alignment_loss, curl_loss, smoothness_loss
 from curvenet.neural.siren import GradientSiren

@@ -1,4 +1,5 @@
-"""End-to-end oracles of the classical surfacer on the analytic networks of curvenet.datasets.shapes."""
+"""End-to-end oracles of the classical surfacer on the analytic networks of
+curvenet.datasets.shapes."""
 
 import numpy as np
 import pytest
