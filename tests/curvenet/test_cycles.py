@@ -173,12 +173,14 @@ def test_torus_gives_exactly_its_faces(shape):
 
     (A ring shorter than the faces, e.g. 3 curves around a tube of 4-sided
     faces, still wins on k alone; that case is out of reach of a tie-break.)"""
-    ps = find_patches(shape.network)
+    assert found(find_patches(shape.network)) == set(shape.face_edge_sets())
+    ps = find_patches(shape.network, mode="basis")
     assert found(ps) == set(shape.face_edge_sets())
     assert len(ps.report["handle_cycles"]) == 2 and ps.report["order"] == "genus_aware"
     assert ps.report["manifold_defect"]["genus_aware"] == 0
     # the paper's weights alone pick planar handle rings over curved faces
-    assert found(find_patches(shape.network, genus_aware=False)) != set(shape.face_edge_sets())
+    paper = find_patches(shape.network, mode="basis", genus_aware=False)
+    assert found(paper) != set(shape.face_edge_sets())
     # the basis itself stays a full basis
-    basis = find_patches(shape.network, close="none")
+    basis = find_patches(shape.network, mode="basis", close="none")
     assert len(basis.patches) == shape.network.cycle_rank()
