@@ -28,12 +28,13 @@ from __future__ import annotations
 import time
 
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 
 from .basis import greedy_basis
 from .candidates import (DEFAULT_MAX_WORK, ENGINES, NUMBA_MIN_WORK, SEPARATING_EPS, TIE_BREAKS,
                          Candidate, CandidatePool)
 from .closing import auto_close, closing_suggestions
-from .gf2 import GF2Eliminator
 from ..core.errors import InvalidParameterError
 from .holes import hole_patches
 from .loops import cycle_to_loop, orient_patches
@@ -276,14 +277,40 @@ def _face_patches(pool, faces, close: str, max_cycle_length=None) -> list:
         if c.edges not in seen:
             seen.add(c.edges)
             unique.append(c)
-    el = GF2Eliminator()
-    kept = [c for c in unique if el.add(c.mask)]
+    kept = _independent_faces(unique, pool.n_edges)
     added = []
     if close == "auto" and kept:
         rest = [c for c in unique if c not in kept] + pool.all_candidates
         added = auto_close(pool, [c.edges for c in kept], max(c.length for c in kept),
                            candidates=rest, faces=seen)
     return [Patch(c.edges, "auto") for c in kept] + [Patch(e, "closing") for e in added]
+
+
+def _independent_faces(faces: list, n_edges: int) -> list:
+    """The faces less the last of each closed group: a GF(2) independent set.
+
+    Each curve bounds at most two faces of an embedding, so a set of them sums to zero
+    only where every curve of it bounds two: a union of *closed* groups (faces joined
+    by shared curves, every curve of the group used twice). Each closed group has that
+    one relation; dropping its last face (``faces`` is in weight order) leaves the rest
+    independent, as the greedy matroid pass would, without an elimination.
+    """
+    if not faces:
+        return []
+    face = np.repeat(np.arange(len(faces)), [c.length for c in faces])
+    edge = np.concatenate([c.edges for c in faces])
+    uses = np.bincount(edge, minlength=n_edges)
+    order = np.argsort(edge, kind="stable")
+    e, f = edge[order], face[order]
+    pair = np.flatnonzero(e[1:] == e[:-1])                  # the two faces of a curve
+    graph = coo_matrix((np.ones(len(pair)), (f[pair], f[pair + 1])),
+                       shape=(len(faces), len(faces)))
+    _, group = connected_components(graph, directed=False)
+    open_group = np.zeros(group.max() + 1, bool)
+    open_group[group[face[uses[edge] != 2]]] = True
+    last = {g: i for i, g in enumerate(group.tolist())}    # the heaviest face per group
+    drop = {i for g, i in last.items() if not open_group[g]}
+    return [c for i, c in enumerate(faces) if i not in drop]
 
 
 def _covers(patches, others) -> bool:

@@ -58,8 +58,10 @@ TRANSPORT_SAMPLES = 17
 #: best one's are tried too (at most MAX_ALTERNATIVES orders per junction)...
 ALTERNATIVE = 0.7
 MAX_ALTERNATIVES = 3
-#: ...in at most this many passes of coordinate descent over those junctions.
+#: ...in at most this many passes of coordinate descent over those junctions, and at
+#: most this many trial embeddings in all (each costs a pass over the network).
 MAX_PASSES = 2
+MAX_TRIALS = 64
 
 
 @dataclass
@@ -315,12 +317,17 @@ def embedded_faces(network: CurveNetwork) -> EmbeddedFaces:
     report.update(junctions=sum(len(hs) >= 3 for hs in J.around.values()),
                   ambiguous=len(doubtful))
     best = _embed(network, J, choice)
+    trials = 0
     for _ in range(MAX_PASSES):
         improved = False
-        for v in doubtful:
-            if not _badness(*best)[0] and not best[2]:
+        # only a junction on a face that is no simple cycle can make it one
+        bad = {int(x) for lp, ok in zip(best[0], best[1]) if not ok
+               for x in _loop_vertices(network, lp)}
+        for v in [v for v in doubtful if v in bad or best[2]]:
+            if (not _badness(*best)[0] and not best[2]) or trials >= MAX_TRIALS:
                 break
             for j in range(1, len(J.options[v])):
+                trials += 1
                 trial = {**choice, v: (choice[v] + j) % len(J.options[v])}
                 got = _embed(network, J, trial)
                 if _badness(*got) < _badness(*best):
@@ -344,6 +351,11 @@ def _embed(network: CurveNetwork, J: _Junctions, choice: dict):
         succ[hs] = np.roll(hs, -1)
     loops, simple = _trace(network, J.chains, succ)
     return loops, simple, conflicts
+
+
+def _loop_vertices(network: CurveNetwork, loop) -> list:
+    """The vertices an oriented loop of ``(edge, forward)`` passes, in order."""
+    return [network.edges[i].u if f else network.edges[i].v for i, f in loop]
 
 
 def _badness(loops, simple, conflicts) -> tuple:
