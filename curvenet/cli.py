@@ -275,6 +275,7 @@ def _surface_one(inp: str, out: str, args) -> dict:
                 "reading": res.diagnostics.get("reading", ""),
                 "snap": res.diagnostics.get("snap", {}).get("summary", ""),
                 "regions": res.decision.explain_regions(),
+                "check": res.decision.explain_check(),
                 "fidelity": res.diagnostics.get("fidelity"),
                 "cad": res.diagnostics.get("cad")}
     except CurvenetError as err:
@@ -347,6 +348,8 @@ def _cmd_surface(args) -> int:
         print(f"route: {row['why']}")
         for line in row.get("regions", []):
             print(f"  region {line}")
+        if row.get("check"):
+            print(row["check"])
         if row.get("fidelity"):
             from .core.fidelity import format_fidelity
             print(format_fidelity(row["fidelity"]))

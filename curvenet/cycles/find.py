@@ -239,7 +239,7 @@ def _choose_faces(network, basis: PatchSet, pool, close: str, mode: str,
                      simple=int(np.count_nonzero(faces.simple)), genus=faces.genus,
                      defect=defect)
     clean = bool(faces.simple.all()) and not faces.report["conflicts"]
-    if patches and (mode == "faces" or clean and defect["faces"] < defect["basis"]
+    if patches and (mode == "faces" or clean and defect["faces"] <= defect["basis"]
                     and _covers(patches, basis.patches)):
         report = dict(basis.report, mode="faces",
                       closing_added=[list(p.edges) for p in patches if p.source == "closing"],
