@@ -325,7 +325,8 @@ def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: f
     PatchMeshResult
         ``face_patch`` indexes ``boundaries``; ``report`` adds ``n_sectors``
         (loops surfaced), ``cuts``, ``flat_patches``, ``flat_meshed`` (those meshed
-        in-plane), ``unsplit_holes`` and ``analytic``: per patch the
+        in-plane), ``unsplit_holes``, ``loop_patch`` (the patch of each loop of the
+        control net, sectors included) and ``analytic``: per patch the
         :meth:`~surfacing.analytic.AnalyticSurface.to_dict` of its surface (with
         ``residual`` in model units) or None; ``curves`` (when asked for) holds the
         input curves only.
@@ -351,6 +352,7 @@ def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: f
     report = dict(res.report, n_patches=len(boundaries), n_sectors=len(loops),
                   cuts=len(all_curves) - n, flat_patches=int(flat.sum()),
                   flat_meshed=int(meshed.sum()), n_faces=len(F), unsplit_holes=unsplit,
+                  loop_patch=owner.tolist(),
                   analytic=[None if s is None else s.to_dict() for s in surfaces])
     new_curves = None if res.curves is None else res.curves[:n]
     return PatchMeshResult(V, F, report, face_patch=face_patch, curves=new_curves,
