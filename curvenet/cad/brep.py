@@ -23,7 +23,6 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..core.errors import CurvenetError
-from ..surfacing.analytic import fit_circle
 from .occ import free_edge_count, heal, is_valid, occ_faces
 
 __all__ = ["CadInputError", "CadModel", "brep_shape", "curve_edges", "analytic_face",
@@ -78,6 +77,8 @@ def _arc_edge(c, closed, v0, v1, tol):
     """A circular arc (full circle when ``closed``) through the samples, or None."""
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
     from OCP.gp import gp_Ax2, gp_Circ
+
+    from ..surfacing.analytic import fit_circle
     got = fit_circle(c, tol=tol)
     if got is None:
         return None
@@ -104,8 +105,8 @@ def _spline_edge(c, v0, v1, tol):
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
     from OCP.GeomAbs import GeomAbs_C2
     from OCP.GeomAPI import GeomAPI_PointsToBSpline
-    from OCP.TColgp import TColgp_Array1OfPnt
-    arr = TColgp_Array1OfPnt(1, len(c))
+    from OCP.OCP.collections import Array1_gp_Pnt
+    arr = Array1_gp_Pnt(1, len(c))
     for i, p in enumerate(c, 1):
         arr.SetValue(i, _pnt(p))
     fit = GeomAPI_PointsToBSpline(arr, 3, 8, GeomAbs_C2, float(tol))
