@@ -124,14 +124,20 @@ class SurfaceResult:
 
 def export_cad(path, result: SurfaceResult, *, schema: str = "AP214",
                level: int | None = None) -> dict:
-    """Write the classical surface of ``result`` as B-spline faces (STEP or 3DM).
+    """Write the classical surface of ``result`` as a B-rep (STEP or 3DM).
+
+    Patches the surfacer found to lie on a plane, cylinder, cone, sphere or torus
+    (``diagnostics["classical"]["analytic"]``) become that surface trimmed by their
+    curves, the others the B-spline pieces of the fitted control mesh
+    (:func:`surfacing.bspline.extract_bsplines`); see :func:`curvenet.cad.write_cad`.
 
     Returns
     -------
     dict
-        ``pieces`` (B-spline report of :func:`surfacing.bspline.extract_bsplines`),
-        ``seams`` (G0 gap, G1 angle and deviation per seam), ``file`` (what the
-        writer reports: faces, shells, solids, free edges, validity).
+        ``pieces`` (B-spline report), ``seams`` (G0 gap, G1 angle and deviation per
+        seam between pieces), ``faces`` (per face its patch, kind and residual),
+        ``file`` (what the writer reports: faces, shells, solids, free edges,
+        validity) and the B-rep figures of :func:`curvenet.cad.brep.brep_shape`.
     """
     from . import cad
     suffix = Path(path).suffix.lower()
@@ -147,17 +153,33 @@ def export_cad(path, result: SurfaceResult, *, schema: str = "AP214",
             f"output {path}: {int(foreign.sum())} faces came from the "
             f"neural fill (a mesh, no B-spline form) and cannot be written as CAD faces; "
             f"save a mesh format or surface with --method classical")
-    holed = sum(bool(p.holes) for p in result.patchset.patches) \
-        if result.patchset is not None else 0
-    if holed and result.diagnostics.get("classical", {}).get("flat_meshed", 0):
-        raise InvalidParameterError(
-            f"output {path}: {holed} faces with holes among flat faces meshed in their "
-            f"plane; their control mesh covers the outer loop only (no trimmed planes in "
-            f"CAD output yet); save a mesh format")
+    from curvenet.surfacing.analytic import AnalyticSurface
     from curvenet.surfacing.bspline import DEFAULT_LEVEL, extract_bsplines
+    from .cycles.loops import orient_boundaries
+    rep = result.diagnostics.get("classical", {})
+    net, ps = result.network, result.patchset
+    surfaces = [None if a is None else AnalyticSurface.from_dict(a)
+                for a in rep.get("analytic", [None] * len(ps.patches))]
+    holed_flat = [k for k, p in enumerate(ps.patches) if p.holes and surfaces[k] is None
+                  and rep.get("flat_meshed", 0)]
+    if holed_flat:
+        raise InvalidParameterError(
+            f"output {path}: {len(holed_flat)} faces with holes among flat faces meshed in "
+            f"their plane, and analytic faces are off (classical_options analytic_tol=None): "
+            f"their control mesh covers the outer loop only; save a mesh format")
+    loop_patch = rep.get("loop_patch", list(range(len(ps.patches))))
     bset = extract_bsplines(result.control_net, DEFAULT_LEVEL if level is None else level)
-    file_report = cad.write_cad(path, bset, schema=schema, wires=result.wires)
-    return {"pieces": bset.report, "seams": bset.seams, "file": file_report}
+    trimmed = [s is not None and s.kind in cad.CAD_KINDS for s in surfaces]
+    free = [pc for pc in bset.pieces if not trimmed[loop_patch[pc.patch]]]
+    diag = bset.report.get("diagonal", 1.0)
+    gap = max([s["gap"] for s in bset.seams] + [rep.get("max_curve_deviation", 0.0)]) * diag
+    model = cad.CadModel(
+        curves=[e.curve for e in net.edges], ends=[(e.u, e.v) for e in net.edges],
+        positions=np.asarray(net.positions, np.float64),
+        boundaries=orient_boundaries(net, ps.patches), surfaces=surfaces, pieces=free,
+        piece_patch=[loop_patch[pc.patch] for pc in free], diagonal=diag, gap=gap)
+    out = cad.write_cad(path, model, schema=schema, wires=result.wires)
+    return {"pieces": bset.report, "seams": bset.seams, **out}
 
 
 def _network(sketch, patchset, *, snap_tol, timings):
