@@ -18,7 +18,11 @@ inside the face it is a hole of is dropped then: the wall now continues through 
 so the hole's face and the wall are the two sides of the loop's curves.
 
 A seam is only taken where every curve of both loops then bounds at most two
-patches, so a seam face never makes a curve non-manifold.
+patches, so a seam face never makes a curve non-manifold, and where the two loops
+face each other as two parallels of one surface of revolution do: their planes
+within 45 degrees of parallel and the line between their centres within 45 degrees
+of their common normal (two leaves on a stem, side by side in one plane, are not the
+ends of a tube).
 """
 
 from __future__ import annotations
@@ -76,10 +80,38 @@ def seam_chains(network: CurveNetwork, patches) -> list:
         va = {x for e in a for x in ends[e]}
         vb = {x for e in b for x in ends[e]}
         inner = {x for e in chain for x in ends[e]} - set(tips)
-        if a == b or va & vb or inner & set(loops_at):
+        if a == b or va & vb or inner & set(loops_at) or not _facing(network, a, b):
             continue
         out.append((chain, a, b))
     return out
+
+
+#: cosine of the largest angle between the loops' normals, and between their common
+#: normal and the line between their centres
+_FACING_COS = np.cos(np.radians(45.0))
+
+
+def _frame(network: CurveNetwork, loop):
+    """Arc-length weighted centre (3,) and unit normal (3,) of a loop's curve points."""
+    pts = np.concatenate([np.asarray(network.edges[e].curve, np.float64) for e in loop])
+    seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
+    w = np.r_[seg, 0.0] + np.r_[0.0, seg]
+    w = w / w.sum() if w.sum() > 0 else np.full(len(pts), 1.0 / len(pts))
+    centre = w @ pts
+    _, _, vt = np.linalg.svd((pts - centre) * np.sqrt(w)[:, None], full_matrices=False)
+    return centre, vt[-1]
+
+
+def _facing(network: CurveNetwork, a, b) -> bool:
+    """Whether loops ``a`` and ``b`` face each other as the ends of a tube do."""
+    (ca, na), (cb, nb) = _frame(network, a), _frame(network, b)
+    cos = float(na @ nb)
+    if abs(cos) < _FACING_COS:
+        return False
+    n = na + np.sign(cos) * nb
+    chord = cb - ca
+    length = float(np.linalg.norm(chord))
+    return length > 0 and abs(float(chord @ n)) >= _FACING_COS * length * np.linalg.norm(n)
 
 
 def _chain(i, ends, at, used, seen):

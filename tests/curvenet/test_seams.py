@@ -115,3 +115,19 @@ def test_seam_faces_never_add_a_third_patch_to_a_curve(seed):
     assert not grew.any()
     for p in after.patches[len(after.patches) - len(after.report["seams"]):]:
         assert len(cycle_to_loop(net, p.edges)) == len(p.edges)
+
+
+def test_two_loops_side_by_side_on_a_stem_are_not_the_ends_of_a_tube():
+    # two leaves in one plane, hung on a stem: each a disc, the stem between them
+    # unused, yet no tube runs from one to the other
+    from curvenet.snap import snap
+    from curvenet.model.sketch import Sketch
+    t = np.linspace(0.0, 1.0, 31)[:, None]
+    u = np.linspace(0.0, 2 * np.pi, 61)[:, None]
+    stem = np.c_[0 * t, 0 * t, 3.0 * t]
+    leaves = [np.c_[s * 0.6 * (1 - np.cos(u)), 0 * u, z + 0.15 * np.sin(u)]
+              for s, z in ((1.0, 1.0), (-1.0, 1.6))]
+    net = snap(Sketch([stem, *leaves], ["boundary"] * 3))
+    ps = find_patches(net)
+    assert ps.report["seams"] == []
+    assert sorted(len(p.edges) for p in ps.patches) == [2, 2]
