@@ -55,6 +55,16 @@ def _positive_int(text: str) -> int:
     return value
 
 
+def _port(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f"{text} is not a port (0..65535)")
+    return value
+
+
 def _edge_length(text: str) -> float:
     """``--edge-length``: a fraction of the diagonal in (0, 1]."""
     try:
@@ -123,6 +133,24 @@ def build_parser() -> argparse.ArgumentParser:
                    help="review patches: delete, accept/reject suggestions, undo, save")
     s.add_argument("--preview", metavar="PNG", help="write a picture of the patches")
     s.add_argument("--up", choices=("x", "y", "z"), default="z", help="up axis of the preview")
+
+    s = sub.add_parser("review", help="review the patches in the browser: click to accept or "
+                                      "reject, Save writes PATCHES.json (needs curvenet[view])")
+    s.add_argument("input", help="sketch file, NETWORK.json or PATCHES.json (reviewed as saved)")
+    s.add_argument("-o", "--output", metavar="PATCHES.json",
+                   help="the file Save writes (default: INPUT-stem.patches.json beside the "
+                        "input); nothing else is written")
+    s.add_argument("--port", type=_port, default=8080,
+                   help="port to serve on (default 8080; the next free one if taken; 0: any)")
+    s.add_argument("--host", default="127.0.0.1",
+                   help="address to bind (default 127.0.0.1: this machine only)")
+    s.add_argument("--no-browser", action="store_true", help="do not open a browser")
+    s.add_argument("--snap-tol", type=_snap_tol, default="auto",
+                   help="fraction of the bbox diagonal, or auto (default)")
+    s.add_argument("--close", choices=("auto", "none"), default="auto",
+                   help="accept solid-closing patches automatically (default auto)")
+    s.add_argument("--points", action="store_true", help=_POINTS_HELP)
+    s.add_argument("--up", choices=("x", "y", "z"), default="z", help="up axis of the view")
 
     s = sub.add_parser("surface", help="surface a sketch, network or patch set")
     s.add_argument("inputs", nargs="+", metavar="INPUT")
@@ -237,6 +265,30 @@ def _cmd_patches(args) -> int:
         from .view.preview import render_preview
         render_preview(args.preview, network=ps.network, patches=ps, title=Path(args.input).name,
                        up=args.up)
+    return 0
+
+
+def _cmd_review(args) -> int:
+    from .pipeline import load_source, patches, surface
+    from .review.web import require_viser, serve_review
+    require_viser()                               # before any work: say which extra
+    stem = Path(args.input)
+    output = args.output or str(stem.with_name(stem.stem + ".patches.json"))
+    check_output_path(output, inputs=[args.input], what="-o")
+    sketch, given = load_source(args.input, points=_points(args))
+    ps = given if given is not None and given.patches else patches(
+        sketch if sketch is not None else given, snap_tol=args.snap_tol, close=args.close)
+    if not ps.patches:
+        raise CurvenetError(f"{args.input}: no patches found, nothing to review")
+
+    def surface_fn(patchset):
+        return surface(sketch if sketch is not None else patchset, patchset=patchset,
+                       method="classical").mesh
+
+    serve_review(dict(patchset=ps, output=output, inputs=[args.input],
+                      strokes=[] if sketch is None else sketch.strokes, surface=surface_fn,
+                      host=args.host, port=args.port, title=Path(args.input).name,
+                      up=args.up), open_browser=not args.no_browser)
     return 0
 
 
@@ -511,8 +563,8 @@ def _on_sigterm(handler):
         return None
 
 
-COMMANDS = {"snap": _cmd_snap, "patches": _cmd_patches, "surface": _cmd_surface,
-            "eval": _cmd_eval}
+COMMANDS = {"snap": _cmd_snap, "patches": _cmd_patches, "review": _cmd_review,
+            "surface": _cmd_surface, "eval": _cmd_eval}
 
 
 def main(argv=None) -> int:

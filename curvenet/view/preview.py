@@ -17,7 +17,8 @@ from ..core.atomic import atomic_path
 from ..core.errors import InvalidParameterError
 from ..core.geometry import as_polyline
 from ..core.tolerances import COINCIDENT_REL, DIVISION_GUARD, ZERO_LENGTH
-from .colours import ROUTE_COLOURS, WIRE_COLOUR
+from .colours import (CURVE_COLOURS, HIGHLIGHT_COLOUR, ROUTE_COLOURS, WIRE_COLOUR,
+                      patch_colours)
 
 __all__ = ["render_preview", "patch_polygons", "decimate_clustering", "DEFAULT_VIEWS",
            "MAX_PREVIEW_FACES"]
@@ -46,11 +47,7 @@ _UP = {"z": ((1, 0, 0), (0, 1, 0), (0, 0, 1)),
 
 _STROKE_COLOUR = (0.25, 0.25, 0.25)
 _CONSTRUCTION_COLOUR = (0.65, 0.65, 0.65)
-_EDGE_COLOURS = {"boundary": (0.12, 0.23, 0.45), "crease": (0.75, 0.22, 0.17)}
 _MESH_COLOUR = np.array([0.72, 0.76, 0.82])
-#: Highlight (a suggested patch): saturated orange, not produced by the patch palette
-#: (its saturation is 0.45), so tests can find it in the picture.
-HIGHLIGHT_COLOUR = (1.0, 0.45, 0.0)
 
 
 # ---------------------------------------------------------------------------
@@ -205,14 +202,6 @@ def _shade(triangles, base, light, ambient=AMBIENT):
     n /= np.maximum(np.linalg.norm(n, axis=1), DIVISION_GUARD)[:, None]
     lam = ambient + (1.0 - ambient) * np.abs(n @ light)
     return np.clip(np.asarray(base, dtype=np.float64).reshape(-1, 3) * lam[:, None], 0, 1)
-
-
-def _palette(k):
-    """``k`` distinct RGB colours: golden-ratio hue steps at saturation 0.45."""
-    from matplotlib.colors import hsv_to_rgb
-
-    hues = (0.1 + 0.618033988749895 * np.arange(k)) % 1.0
-    return hsv_to_rgb(np.column_stack([hues, np.full(k, 0.45), np.full(k, 0.95)]))
 
 
 # ---------------------------------------------------------------------------
@@ -415,7 +404,7 @@ def _patch_fans(network, edge_sets, hl_index, hl_extra):
         One entry per polygon.
     """
     fill = [(edges, HIGHLIGHT_COLOUR if i in hl_index else colour)
-            for i, (edges, colour) in enumerate(zip(edge_sets, _palette(len(edge_sets))))]
+            for i, (edges, colour) in enumerate(zip(edge_sets, patch_colours(len(edge_sets))))]
     fill += [(edges, HIGHLIGHT_COLOUR) for edges in hl_extra]
     tris, rgb, amb = [], [], []
     for edges, colour in fill:
@@ -486,7 +475,7 @@ class _Scene:
         """Rotate by ``rot`` (3, 3) and bound; raises when there is nothing to draw."""
         net_curves = [] if network is None else [e.curve for e in network.edges]
         net_colours = [] if network is None else [
-            _EDGE_COLOURS.get(e.label, _EDGE_COLOURS["boundary"]) for e in network.edges]
+            CURVE_COLOURS.get(e.label, CURVE_COLOURS["boundary"]) for e in network.edges]
         net_pos = (np.zeros((0, 3)) if network is None or not net_curves
                    else network.positions)
         lines = [x @ rot for x in lines]
