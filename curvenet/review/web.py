@@ -185,10 +185,11 @@ class ReviewPage:
         self._layers = {}
         if len(strokes):
             self._layers["show strokes"] = [s.scene.add_line_segments(
-                "/strokes", strokes, colors=_rgb(_STROKE_COLOUR), line_width=1.0)]
+                "/strokes", strokes, colors=_rgb(_STROKE_COLOUR), thickness=1.0,
+                thickness_units="screen")]
         net_nodes = [s.scene.add_line_segments("/network/curves", curves,
                                                colors=(255 * curve_rgb).astype(np.uint8),
-                                               line_width=2.5)]
+                                               thickness=2.5, thickness_units="screen")]
         if len(junctions):
             net_nodes.append(s.scene.add_point_cloud(
                 "/network/junctions", junctions, colors=(20, 20, 20),
@@ -269,6 +270,27 @@ class ReviewPage:
         return [e.edges in current for e in self._entries]
 
     @property
+    def selected(self) -> int | None:
+        """The selected row, or None."""
+        return self._selected
+
+    @property
+    def alternatives(self) -> list:
+        """The selected row's alternatives (Suggestion), best first; the drawn one is
+        ``alternatives[shown]``."""
+        return list(self._alternatives)
+
+    @property
+    def shown(self) -> int:
+        """Index of the alternative drawn."""
+        return self._shown
+
+    @property
+    def status(self) -> str:
+        """The panel's status text (Markdown)."""
+        return self._status.content
+
+    @property
     def patchset(self) -> PatchSet:
         """The ticked rows in panel order, as ``Save`` writes them."""
         report = self.session.patchset.report
@@ -288,12 +310,13 @@ class ReviewPage:
             if accepted == self.accepted()[index]:
                 self._paint(index)          # our own repaint of the checkbox, or a repeat
                 return
-            self._paint(index, accepted=accepted)       # the view first
+            self._paint_mesh(index, accepted)           # the view first
             if accepted:
                 self.session.accept(entry.edges)
             else:
                 self.session.delete(entry.edges, top=0)
             self._steps.append(1)
+            self._paint(index)
             if not accepted or self._selected == index:
                 self.select(index)
             self._refresh_panel()
@@ -425,18 +448,21 @@ class ReviewPage:
             self.select(0 if self._selected is None and step > 0 else
                         n - 1 if self._selected is None else (self._selected + step) % n)
 
-    def _paint(self, index: int, *, accepted: bool | None = None) -> None:
-        """Colour row ``index``'s mesh and checkbox from the session (or ``accepted``)."""
+    def _paint(self, index: int) -> None:
+        """Row ``index``'s mesh and checkbox as the session has it."""
         entry = self._entries[index]
-        if accepted is None:
-            accepted = entry.edges in {p.edges for p in self.session.patches}
+        accepted = entry.edges in {p.edges for p in self.session.patches}
+        self._paint_mesh(index, accepted)
+        entry.checkbox.value = accepted   # its callback sees the session agree: no action
+
+    def _paint_mesh(self, index: int, accepted: bool) -> None:
+        entry = self._entries[index]
         colour = (HIGHLIGHT_COLOUR if index == self._selected else
                   entry.colour if accepted else REJECTED_COLOUR)
         with self.server.atomic():
             entry.mesh.color = _rgb(colour)
             entry.mesh.opacity = None if accepted else REJECTED_OPACITY + 0.3 * (
                 index == self._selected)
-            entry.checkbox.value = accepted
 
     def _draw_alternative(self) -> None:
         for node in self._alt_nodes:
@@ -455,7 +481,7 @@ class ReviewPage:
                                                   cast_shadow=False),
                 self.server.scene.add_line_segments("/alternative/curves", seg,
                                                     colors=_rgb(ALTERNATIVE_COLOUR),
-                                                    line_width=5.0)]
+                                                    thickness=5.0, thickness_units="screen")]
 
     def _show_layer(self, name: str) -> None:
         visible = self._layer_boxes[name].value
@@ -514,11 +540,11 @@ def serve_review(page_args: dict, *, open_browser: bool = True, say=print,
     and returns; unsaved changes are named, not written: only ``Save`` writes.
     """
     page = ReviewPage(**page_args)
-    say(f"review: {page.url}  ({len(page.labels)} patches; Save writes {page.output}; "
-        "Ctrl-C stops)")
-    if open_browser:
-        webbrowser.open(page.url)
     try:
+        say(f"review: {page.url}  ({len(page.labels)} patches; Save writes {page.output}; "
+            "Ctrl-C stops)")
+        if open_browser:
+            webbrowser.open(page.url)
         while True:
             time.sleep(poll)
     except KeyboardInterrupt:
