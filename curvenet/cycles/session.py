@@ -156,8 +156,11 @@ class PatchSession:
         return self.pool.cycle_rank
 
     def rank(self) -> int:
-        """GF(2) rank of the current patches (galois)."""
-        return gf2_rank([edge_mask(p.edges) for p in self._patches], self.network.number_of_edges)
+        """GF(2) rank of the current patches, by the session's ``backend``."""
+        masks = [edge_mask(p.edges) for p in self._patches]
+        if self.backend == "galois":
+            return gf2_rank(masks, self.network.number_of_edges)
+        return len(masks) - len(bitset_solve(masks, [])[1])   # minus the dependencies
 
     def _solve(self, targets):
         pm = [edge_mask(p.edges) for p in self._patches]

@@ -92,8 +92,10 @@ def test_backends_agree(two_boxes):
     a = PatchSession(ps, backend="galois")
     b = PatchSession(ps, backend="bitset")
     assert [s.edges for s in a.closing_suggestions()] == [s.edges for s in b.closing_suggestions()]
+    assert a.rank() == b.rank() == a.full_rank                  # a basis: no solid closed
     a.delete(3)
     b.delete(3)
+    assert a.rank() == b.rank() == a.full_rank - 1
     assert [s.edges for s in a.replacement_suggestions()] \
         == [s.edges for s in b.replacement_suggestions()]
 
