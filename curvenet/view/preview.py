@@ -23,8 +23,13 @@ from .colours import (CURVE_COLOURS, HIGHLIGHT_COLOUR, ROUTE_COLOURS, WIRE_COLOU
 __all__ = ["render_preview", "patch_polygons", "decimate_clustering", "DEFAULT_VIEWS",
            "MAX_PREVIEW_FACES"]
 
-#: Default camera(s): ``(elevation, azimuth)`` in degrees, one panel each (front and back).
-DEFAULT_VIEWS = ((20.0, -60.0), (20.0, 120.0))
+#: Default cameras: ``(elevation, azimuth)`` in degrees, one panel each: front and back.
+#: The back camera is the front one's antipode (azimuth 180 degrees on, elevation
+#: negated), so the two look along opposite directions: every face that a convex shape
+#: turns away from one camera faces the other, and the pair shows each face once
+#: (the bottom too, where a missing patch hides). Two cameras both above, 180 degrees
+#: apart, see the same top twice and read as nearly the same picture.
+DEFAULT_VIEWS = ((20.0, -60.0), (-20.0, 120.0))
 
 #: Meshes with more faces are decimated (vertex clustering) before drawing.
 MAX_PREVIEW_FACES = 60_000
@@ -32,8 +37,11 @@ MAX_PREVIEW_FACES = 60_000
 #: Patch fans are cut into this many rings (smaller pieces sort better in depth).
 FAN_RINGS = 4
 
-#: Camera zoom of each panel (matplotlib leaves room for the hidden axes at 1.0).
-ZOOM = 1.1
+#: Share of a panel's width and height that the shape's projected bounding box fills
+#: (the rest is margin): the camera zoom is chosen per panel to fit it.
+FILL = 0.92
+#: Measure-and-correct passes of the fit (the second one only tidies rounding).
+FIT_PASSES = 2
 
 #: Lambert shading: ``AMBIENT + (1 - AMBIENT) * |n . l|`` (two-sided: orientation-agnostic);
 #: highlighted patches use the larger HIGHLIGHT_AMBIENT so they stay bright.
@@ -510,14 +518,18 @@ def _figure(scene: _Scene, views, width: int, height: int, title):
     fig = Figure(figsize=(width / 100.0, height / 100.0), dpi=100)
     FigureCanvasAgg(fig)
     fig.patch.set_facecolor("white")
+    axes = []
     for i, (elev, azim) in enumerate(views):
         ax = fig.add_subplot(1, len(views), i + 1, projection="3d")
         ax.computed_zorder = False  # our zorder: surfaces, then curves on top
-        _draw_panel(ax, scene, _light(elev, azim))
         _frame(ax, scene.lo, scene.hi, elev, azim)
+        axes.append(ax)
     if title:
         fig.suptitle(str(title), fontsize=11)
     fig.subplots_adjust(left=0, right=1, bottom=0, top=0.94 if title else 1, wspace=0)
+    _fit(fig, axes, scene.lo, scene.hi)     # on the empty panels: a cheap draw
+    for ax, (elev, azim) in zip(axes, views):
+        _draw_panel(ax, scene, _light(elev, azim))
     return fig
 
 
@@ -552,15 +564,61 @@ def _draw_panel(ax, scene: _Scene, light):
                                              linewidths=3.0, zorder=7))
 
 
-def _frame(ax, lo, hi, elev, azim):
-    """Equal aspect around the data's bounding box, axes hidden, camera set."""
-    centre = 0.5 * (lo + hi)
+def _box(lo, hi):
+    """The drawn box ``(centre, extent)``: the bounds, a flat side kept 2% thick."""
     ext = hi - lo
     big = max(float(ext.max()), ZERO_LENGTH)
-    ext = np.maximum(ext, 0.02 * big)  # flat data keeps a thin box
+    return 0.5 * (lo + hi), np.maximum(ext, 0.02 * big)
+
+
+def _frame(ax, lo, hi, elev, azim):
+    """Equal aspect around the data's bounding box, axes hidden, orthographic camera set."""
+    centre, ext = _box(lo, hi)
     ax.set_xlim(centre[0] - ext[0] / 2, centre[0] + ext[0] / 2)
     ax.set_ylim(centre[1] - ext[1] / 2, centre[1] + ext[1] / 2)
     ax.set_zlim(centre[2] - ext[2] / 2, centre[2] + ext[2] / 2)
-    ax.set_box_aspect(tuple(ext), zoom=ZOOM)
+    ax.set_box_aspect(tuple(ext))
+    ax.set_proj_type("ortho")
     ax.view_init(elev=elev, azim=azim)
     ax.set_axis_off()
+
+
+def _fit(fig, axes, lo, hi) -> None:
+    """Zoom each panel so that the bounding box's projection fills :data:`FILL` of it.
+
+    matplotlib sizes a 3D panel for its (hidden) axes box seen from any side, so a long
+    shape seen along its diagonal overflows a narrow panel while a compact one floats
+    small. Under the orthographic camera the projection scales linearly with the zoom:
+    one measurement of the eight corners per panel gives the zoom exactly.
+    """
+    from mpl_toolkits.mplot3d import proj3d
+
+    centre, ext = _box(lo, hi)
+    corners = centre + ext * (np.indices((2, 2, 2)).reshape(3, -1).T - 0.5)  # (8, 3)
+    fw, fh = fig.get_size_inches()
+    panels = [ax.get_subplotspec().get_position(fig) for ax in axes]
+    for ax, pb in zip(axes, panels):
+        # a 3D panel draws in a square: make it the panel's longer side, centred on it
+        side = max(pb.width * fw, pb.height * fh)
+        ax.set_position([pb.x0 + pb.width / 2 - side / fw / 2,
+                         pb.y0 + pb.height / 2 - side / fh / 2, side / fw, side / fh])
+        ax.patch.set_visible(False)         # squares overlap: none may paint over another
+    zoom = [1.0] * len(axes)
+    for _ in range(FIT_PASSES):
+        fig.draw_without_rendering()
+        for i, (ax, pb) in enumerate(zip(axes, panels)):
+            x, y, _ = proj3d.proj_transform(*corners.T, ax.get_proj())
+            px = ax.transData.transform(np.column_stack([x, y]))       # (8, 2) pixels
+            size = np.maximum(np.ptp(px, axis=0), 1.0)
+            box = pb.transformed(fig.transFigure)
+            scale = FILL * min(box.width / size[0], box.height / size[1])
+            zoom[i] *= scale
+            ax.set_box_aspect(tuple(ext), zoom=zoom[i])
+            # the projection scales about the axes' centre: move the axes so that the
+            # projection's centre lands on the panel's
+            a = np.array([ax.bbox.x0 + ax.bbox.x1, ax.bbox.y0 + ax.bbox.y1]) / 2
+            d = (px.min(axis=0) + px.max(axis=0)) / 2 - a
+            shift = np.array([box.x0 + box.x1, box.y0 + box.y1]) / 2 - d * scale - a
+            pos = ax.get_position()
+            ax.set_position([pos.x0 + shift[0] / fig.bbox.width,
+                             pos.y0 + shift[1] / fig.bbox.height, pos.width, pos.height])
