@@ -449,13 +449,24 @@ def _preview_mesh(mesh, face_route, routes):
     return v, f, table[route[index]].reshape(-1, 3)
 
 
-def _legend(fig, routes, wires: bool) -> None:
-    """Route names (and "wires") in their colours along the picture's bottom edge."""
-    names = [(r, ROUTE_COLOURS.get(r, _MESH_COLOUR)) for r in routes]
+def _legend(fig, routes, wires: bool):
+    """Route names (and "wires") in their colours along the picture's bottom edge.
+
+    One matplotlib legend, its entries in a row: matplotlib measures each label, so the
+    swatches and names never overlap, at any picture width. Returns the Legend (None
+    when there is nothing to name).
+    """
+    from matplotlib.patches import Patch as Swatch
+
+    names = [(str(r), ROUTE_COLOURS.get(r, _MESH_COLOUR)) for r in routes]
     names += [("wires", WIRE_COLOUR)] if wires else []
-    for k, (name, colour) in enumerate(names):
-        fig.text(0.01 + 0.12 * k, 0.01, "\u25a0 " + name, color=colour, fontsize=10,
-                 fontweight="bold")
+    if not names:
+        return None
+    return fig.legend(handles=[Swatch(facecolor=c, label=n) for n, c in names],
+                      loc="lower left", ncols=len(names), frameon=False,
+                      labelcolor=[c for _, c in names], handlelength=1.0,
+                      handleheight=1.0, handletextpad=0.4, columnspacing=1.2,
+                      borderaxespad=0.3, prop={"weight": "bold", "size": 9})
 
 
 @dataclass

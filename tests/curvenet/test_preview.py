@@ -266,3 +266,32 @@ def _orange(img):
 
     hsv = rgb_to_hsv(img)
     return (np.abs(hsv[..., 0] - 0.075) < 0.02) & (hsv[..., 1] > 0.9) & (hsv[..., 2] > 0.5)
+
+
+def _overlap(a, b) -> bool:
+    return a.x0 < b.x1 and b.x0 < a.x1 and a.y0 < b.y1 and b.y0 < a.y1
+
+
+@pytest.mark.parametrize("width", [360, 200, 900])
+def test_legend_entries_do_not_overlap_their_text(width):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from curvenet.view.preview import _legend
+
+    fig = Figure(figsize=(width / 100, 3.0), dpi=100)
+    FigureCanvasAgg(fig)
+    legend = _legend(fig, ("classical", "neural", "hybrid"), True)
+    renderer = fig.canvas.get_renderer()
+    fig.draw(renderer)
+    texts = [t.get_window_extent(renderer) for t in legend.get_texts()]
+    swatches = [h.get_window_extent(renderer) for h in legend.legend_handles]
+    assert [t.get_text() for t in legend.get_texts()] == ["classical", "neural", "hybrid",
+                                                         "wires"]
+    boxes = texts + swatches
+    for i, a in enumerate(boxes):
+        for b in boxes[i + 1:]:
+            assert not _overlap(a, b), (a, b)
+    for a, b in zip(swatches, texts):                     # each swatch left of its name
+        assert a.x1 <= b.x0
+    assert _legend(fig, (), False) is None
