@@ -29,6 +29,7 @@ import numpy as np
 
 from ..core.atomic import check_output_path
 from ..core.errors import CurvenetError, InvalidParameterError, MissingDependencyError
+from ..core.tolerances import DIVISION_GUARD
 from ..cycles.session import PatchSession
 from ..io.network import write_patches
 from ..model.patchset import PatchSet
@@ -55,8 +56,9 @@ SHORTCUTS = (("A", None, "accept the selected patch"),
              ("F", None, "surface"))
 #: A rejected patch: grey and faint, still there to click and accept again.
 REJECTED_COLOUR, REJECTED_OPACITY = (0.62, 0.62, 0.62), 0.2
-#: The alternative shown for the selected patch.
-ALTERNATIVE_COLOUR, ALTERNATIVE_OPACITY = (0.0, 0.62, 0.55), 0.65
+#: The alternative shown for the selected patch, lifted this share of the camera
+#: distance off the surface it may share with patches.
+ALTERNATIVE_COLOUR, ALTERNATIVE_OPACITY, ALTERNATIVE_LIFT = (0.0, 0.62, 0.55), 0.65, 0.002
 #: Hemisphere fill (white sky along the up axis) and a key light above the first camera.
 FILL_LIGHT, KEY_LIGHT = 1.6, 1.4
 _STROKE_COLOUR = (0.25, 0.25, 0.25)
@@ -195,6 +197,7 @@ class ReviewPage:
         s.initial_camera.look_at = tuple(look_at)
         s.initial_camera.up = tuple(up_dir)
         scale = float(np.linalg.norm(position - look_at))
+        self._lift = ALTERNATIVE_LIFT * scale
         self._layers = {}
         if len(strokes):
             self._layers["show strokes"] = [s.scene.add_line_segments(
@@ -486,16 +489,25 @@ class ReviewPage:
             return
         edges = self._alternatives[self._shown].edges
         v, f = patch_mesh(self.network, edges)
+        # An alternative shares its curves, often its plane, with patches: drawn where
+        # they are it would flicker through them (z-fighting). Two copies lifted off
+        # each side along the fan's normals: one of them is always in front.
+        normals = np.zeros_like(v)
+        tri = v[f]
+        np.add.at(normals, f, np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])[:, None])
+        normals /= np.maximum(np.linalg.norm(normals, axis=1, keepdims=True), DIVISION_GUARD)
         seg = polyline_segments([self.network.edges[e].curve for e in edges])
         with self.server.atomic():
             self._alt_nodes = [
-                self.server.scene.add_mesh_simple("/alternative/patch", v, f,
+                self.server.scene.add_mesh_simple(f"/alternative/{side}",
+                                                  v + sign * self._lift * normals, f,
                                                   color=_rgb(ALTERNATIVE_COLOUR),
                                                   opacity=ALTERNATIVE_OPACITY, side="double",
-                                                  cast_shadow=False, receive_shadow=False),
-                self.server.scene.add_line_segments("/alternative/curves", seg,
-                                                    colors=_rgb(ALTERNATIVE_COLOUR),
-                                                    thickness=5.0, thickness_units="screen")]
+                                                  cast_shadow=False, receive_shadow=False)
+                for side, sign in (("front", 1.0), ("back", -1.0))]
+            self._alt_nodes.append(self.server.scene.add_line_segments(
+                "/alternative/curves", seg, colors=_rgb(ALTERNATIVE_COLOUR), thickness=5.0,
+                thickness_units="screen"))
 
     def _show_layer(self, name: str) -> None:
         visible = self._layer_boxes[name].value

@@ -33,6 +33,12 @@ def test_missing_viser_names_the_extra(monkeypatch):
         require_viser()
 
 
+def test_graph_commands_do_not_import_viser():
+    code = ("import sys, curvenet, curvenet.cli, curvenet.review; "
+            "curvenet.cli.build_parser(); sys.exit('viser' in sys.modules)")
+    assert subprocess.run([sys.executable, "-c", code]).returncode == 0
+
+
 viser = pytest.importorskip("viser")
 from curvenet.review.web import ReviewPage  # noqa: E402
 
