@@ -198,7 +198,10 @@ class PatchSession:
         if not cands:
             return []
         sols, _ = self._solve(cands)
-        free = [c for c, x in zip(cands, sols) if x is None]
+        return self._replacements([c for c, x in zip(cands, sols) if x is None], top)
+
+    def _replacements(self, free, top: int) -> list:
+        """Candidates outside the span as replacement suggestions, by Sec. 4.2 weight."""
         self.pool.classify(free)
         free.sort(key=lambda c: c.key)
         return [Suggestion(c.edges, "replacement", float(c.k), c.length,
@@ -262,12 +265,7 @@ class PatchSession:
                     for s in out[:top]]
         sols = (gf2_solve(masks, [c.mask for c in near], self.network.number_of_edges)[0]
                 if self.backend == "galois" else bitset_solve(masks, [c.mask for c in near])[0])
-        free = [c for c, x in zip(near, sols) if x is None]
-        self.pool.classify(free)
-        free.sort(key=lambda c: c.key)
-        return [Suggestion(c.edges, "replacement", float(c.k), c.length,
-                           {"k": float(c.k), "volume": c.volume, "separating": c.separating})
-                for c in free[:top]]
+        return self._replacements([c for c, x in zip(near, sols) if x is None], top)
 
     # --- actions ------------------------------------------------------------------
     def delete(self, patch, *, top: int = DEFAULT_TOP) -> list:
