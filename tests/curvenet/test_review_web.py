@@ -101,8 +101,8 @@ def test_alternatives_of_a_selected_patch_and_using_one(page_of):
     assert "alternative 1 of" in page._selection_text.content
     page.next_alternative()
     assert page.shown == (1 % len(alts))
+    used = alts[page.shown]
     page.use_alternative()
-    used = alts[page.shown if len(alts) == 1 else 1]
     assert page.labels[-1] == f"patch {n + 1}" and page.accepted() == [False] + [True] * n
     assert page.patchset.patches[-1].edges == used.edges
     assert page.patchset.patches[-1].source == "user"
