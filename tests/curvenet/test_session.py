@@ -243,3 +243,21 @@ def test_interactive_preview_png(tmp_path, box):
     run_interactive(find_patches(box.network, close="none"), input=io.StringIO("c\nn\nq\nq\n"),
                     output=io.StringIO(), preview=png, backend="bitset")
     assert png.is_file() and png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_interactive_offers_the_cycles_through_a_rejected_patch(two_boxes):
+    # a wrong patch taken out: the first offered are the cycles through its curves that
+    # could take its place; a rejected offer is followed by the cycles through its own
+    ps0 = find_patches(two_boxes.network, close="none")
+    expected = PatchSession(ps0, backend="bitset").alternatives_to(0)
+    out = io.StringIO()
+    ps = run_interactive(ps0, input=io.StringIO("d 0\nr\na\nq\n"), output=out,
+                         backend="bitset")
+    text = out.getvalue()
+    assert f"#1 {expected[0].describe()}" in text
+    first, second = [line for line in text.splitlines() if line.lstrip().startswith("#")][:2]
+    rejected = set(expected[0].edges)
+    assert "alternatives through its curves next" in text
+    accepted = ps.patches[-1].edges
+    assert accepted != expected[0].edges and not rejected.isdisjoint(accepted)
+    assert str(list(accepted)) in second
