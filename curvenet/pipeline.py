@@ -19,7 +19,7 @@ import numpy as np
 
 from .cad.export import CAD_FORMATS
 from .core.errors import CurvenetError, InvalidParameterError
-from .core.fidelity import sketch_fidelity
+from .core.fidelity import sketch_fidelity, stroke_fidelity
 from .core.result import MeshResult
 from .io.source import check_patches_match, load_source
 from .io.meshes import MESH_FORMATS, write_mesh, write_routed
@@ -405,15 +405,46 @@ def _surface_route(plan: _Plan, decision: RouteDecision, settings: SurfaceSettin
     return res, name
 
 
+def _nonmanifold(ps) -> int:
+    """Curves of ``ps``'s network that bound three or more of its patches."""
+    uses = np.zeros(ps.network.number_of_edges, np.int64)
+    for p in ps.patches:
+        np.add.at(uses, list(p.all_edges), 1)
+    return int(np.count_nonzero(uses >= 3))
+
+
+def _area_share(res, patches) -> float:
+    """Share of the surface's area on the faces of ``patches`` (patch indices)."""
+    V, F = np.asarray(res.vertices), np.asarray(res.faces)
+    area = np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
+    total = float(area.sum())
+    return float(area[np.isin(res.face_patch, list(patches))].sum() / total) if total else 0.0
+
+
+#: Walls on less than this share of the classical surface's area are reported and kept:
+#: a sliver is not worth a neural fit that would lose strokes elsewhere.
+JUDGE_WALL_AREA = 0.01
+#: The neural surface replaces a judged classical one only when its stroke fidelity is
+#: at most this much below the classical surface's (a share of stroke length).
+JUDGE_FIDELITY_MARGIN = 0.02
+
+
 def _judge(plan: _Plan, decision: RouteDecision, settings: SurfaceSettings, close: str, *,
            sketch, net, ps, res, name, timings, diag):
     """``auto``'s check of the classical surface, and what it takes when the check fails.
 
     The surface passes when no patch is a wall inside the shape the others bound
-    (:func:`~curvenet.route.check.judge_patches`). Otherwise the other patch selection
-    (:func:`~curvenet.cycles.find_patches` ``mode="faces"`` or ``"basis"``) is surfaced
-    and judged, and kept if it passes; if neither passes, the neural route surfaces the
-    strokes. Returns ``(result, patch set, decision with its check, name)``.
+    (:func:`~curvenet.route.check.judge_patches`). When it does not, or when some of its
+    curves bound three or more patches and the other patch selection
+    (:func:`~curvenet.cycles.find_patches` ``mode="faces"`` or ``"basis"``) has fewer
+    such curves, that selection is surfaced and kept if it covers at least the curve
+    length the first covers, has no walls and fewer such curves (or the first has
+    walls). A surface whose walls hold at least :data:`JUDGE_WALL_AREA` of its area and
+    that has no such replacement goes to the neural route, which is kept if its
+    stroke fidelity is at most :data:`JUDGE_FIDELITY_MARGIN` below the classical
+    surface's; else the classical surface stays, walls and all (a wrong shape through
+    the strokes is not traded for a surface that misses them). Returns ``(result,
+    patch set, decision with its check, name)``.
     """
     if getattr(res, "face_patch", None) is None:
         return res, ps, decision, name
@@ -426,29 +457,41 @@ def _judge(plan: _Plan, decision: RouteDecision, settings: SurfaceSettings, clos
     first = judge(res, ps)
     mode = ps.report.get("mode", "basis")
     check = {"walls": {mode: len(first["walls"])}, "nonmanifold": first["nonmanifold"],
-             "taken": mode}
-    if first["passes"]:
+             "coverage": {mode: diag["coverage"]}, "taken": mode}
+    if first["passes"] and not first["nonmanifold"]:
         return res, ps, replace(decision, check=check), name
     from .cycles.find import find_patches
     other = "faces" if mode == "basis" else "basis"
     alt = find_patches(net, close=close, mode=other)
-    if alt.patches:
+    check["coverage"][other] = coverage(alt)[0]
+    better = not first["passes"] or _nonmanifold(alt) < first["nonmanifold"]
+    if alt.patches and better and check["coverage"][other] >= diag["coverage"] - 1e-9:
         alt_res, alt_name = _surface_route(plan, decision, settings, sketch=sketch, net=net,
                                            ps=alt, timings=timings, diag=diag)
         verdict = judge(alt_res, alt)
         check["walls"][other] = len(verdict["walls"])
-        if verdict["passes"]:
+        if verdict["passes"] and (not first["passes"]
+                                  or verdict["nonmanifold"] < first["nonmanifold"]):
             check.update(taken=other, nonmanifold=verdict["nonmanifold"])
             diag["patches"] = len(alt.patches)
             return alt_res, alt, replace(decision, patches=len(alt.patches), check=check), alt_name
+    check["wall_area"] = _area_share(res, first["walls"])
+    if first["passes"] or check["wall_area"] < JUDGE_WALL_AREA:
+        return res, ps, replace(decision, check=check), name
     strokes, labels = _strokes(sketch, net)
-    res = _run(plan.stroke, SurfaceInput(settings, strokes=strokes, labels=labels),
-               plan.options[plan.stroke.name], timings, diag)
+    neural = _run(plan.stroke, SurfaceInput(settings, strokes=strokes, labels=labels),
+                  plan.options[plan.stroke.name], timings, diag)
+    ref = sketch if sketch is not None else net
+    check["fidelity"] = {
+        "classical": stroke_fidelity((res.vertices, res.faces), ref)["fidelity"],
+        "neural": stroke_fidelity((neural.vertices, neural.faces), ref)["fidelity"]}
+    if check["fidelity"]["neural"] < check["fidelity"]["classical"] - JUDGE_FIDELITY_MARGIN:
+        return res, ps, replace(decision, check=check), name
     check["taken"] = "neural"
     decision = replace(decision, route=Route.NEURAL, surfacer=plan.stroke.name, reason="judged",
                        check=check)
     diag["decision"] = decision.explain()
-    return res, ps, decision, plan.stroke.label
+    return neural, ps, decision, plan.stroke.label
 
 
 def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
@@ -528,7 +571,8 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
         raise CurvenetError("no patches found: the curves form no cycles; try --method neural")
     res, name = _surface_route(plan, decision, settings, sketch=sketch, net=net, ps=ps,
                                timings=timings, diag=diag)
-    if method == "auto" and decision.route is Route.CLASSICAL and not plan.refine:
+    if (method == "auto" and decision.route is Route.CLASSICAL and not plan.refine
+            and (given is None or not given.patches)):      # patches given are the user's
         res, ps, decision, name = _judge(plan, decision, settings, close, sketch=sketch, net=net,
                                          ps=ps, res=res, name=name, timings=timings, diag=diag)
     if len(res.faces) == 0:

@@ -116,7 +116,8 @@ REASONS = {
     "unstructured": "patches cover only {coverage:.0%} of the curve length and most of "
                     "the rest spans area: one neural surface",
     "judged": "{patches} patches cover {coverage:.0%} of the curve length, but every patch "
-              "set leaves walls inside the shape (check below): one neural surface",
+              "set leaves walls inside the shape and the neural surface holds the strokes "
+              "as well (check below): one neural surface",
 }
 
 
@@ -144,8 +145,11 @@ class RouteDecision:
     check : dict or None
         ``auto``'s judgement of the classical surface (:func:`curvenet.route.check.
         judge_patches`): ``walls`` (patch mode -> patches inside the shape the others
-        bound), ``nonmanifold`` (curves bounding three or more patches), ``taken`` (the
-        patch mode kept, or ``"neural"``); None when not judged.
+        bound), ``nonmanifold`` (curves bounding three or more patches), ``coverage``
+        (patch mode -> share of curve length its patches use), ``wall_area`` (share of
+        the first surface's area on its walls, when it has some), ``fidelity`` (when the
+        neural route was tried: ``classical`` and ``neural`` stroke fidelity), ``taken``
+        (the patch mode kept, or ``"neural"``); None when not judged.
 
     Examples
     --------
@@ -184,10 +188,20 @@ class RouteDecision:
         """
         if self.check is None:
             return None
-        walls = ", ".join(f"{mode} {n}" for mode, n in self.check["walls"].items())
-        taken = self.check["taken"]
+        c = self.check
+        walls = ", ".join(f"{mode} {n}" for mode, n in c["walls"].items())
+        if c.get("wall_area"):
+            walls += f" ({c['wall_area']:.1%} of the area)"
+        taken = c["taken"]
         kept = "took the neural route" if taken == "neural" else f"kept the {taken} patches"
-        return f"check: walls: {walls}; {kept}; {self.check['nonmanifold']} curves in 3+ patches"
+        covered = c.get("coverage", {})
+        cov = ("; coverage " + ", ".join(f"{m} {v:.0%}" for m, v in covered.items())
+               if len(covered) > 1 else "")
+        fid = c.get("fidelity")
+        fid = (f"; stroke fidelity classical {fid['classical']:.0%}, neural {fid['neural']:.0%}"
+               if fid else "")
+        return (f"check: walls: {walls}{cov}{fid}; {kept}; {c['nonmanifold']} curves in 3+ "
+                f"patches")
 
     def explain_regions(self) -> list:
         """One line per region (:meth:`Region.explain`)."""
