@@ -134,8 +134,7 @@ class Candidate:
 class CandidatePool:
     """Candidate cycles of a network, enumerated length by length (Algorithm 1).
 
-    Precomputes adjacency, per-vertex search distances and per-edge geometric
-    moments once; :meth:`cycles_of_length` then enumerates and weighs all simple
+    Precomputes adjacency and per-edge geometric moments once; :meth:`cycles_of_length` then enumerates and weighs all simple
     cycles of one length, each exactly once.
 
     Parameters
@@ -159,7 +158,8 @@ class CandidatePool:
     depth-first search through vertices ``> s`` and kept only when its first
     edge id is smaller than its last (each undirected cycle has two directions).
     Paths are pruned when ``depth + dist_s(x) > L``, with ``dist_s`` the
-    breadth-first distance to ``s`` inside the vertices ``>= s``.
+    breadth-first distance to ``s`` inside the vertices ``>= s``, searched up to
+    ``L // 2`` hops (as the numba kernel does: no vertex of such a cycle lies farther).
     """
 
     def __init__(self, network: CurveNetwork, *, tie_break: str = "pca",
@@ -187,7 +187,6 @@ class CandidatePool:
             lst.sort()
         self.nbrs = [sorted({y for y, _ in lst}) for lst in self.adj]
         self.loops = [e for e, (u, v) in enumerate(ends.tolist()) if u == v]
-        self._dist = [None] * nv
         self._by_length: dict = {}        # L -> candidates of cycles_of_length(L)
         self._candidates: list = []       # every candidate handed out, in enumeration order
         self._sorted = None               # cache of all_candidates
@@ -237,19 +236,24 @@ class CandidatePool:
             c += 1
         return comp
 
-    def _dist_from(self, s: int) -> dict:
-        d = self._dist[s]
-        if d is None:
-            d = {s: 0}
-            q = deque([s])
-            while q:
-                x = q.popleft()
-                dx = d[x] + 1
-                for y in self.nbrs[x]:
-                    if y > s and y not in d:
-                        d[y] = dx
-                        q.append(y)
-            self._dist[s] = d
+    def _dist_from(self, s: int, reach: int) -> dict:
+        """Hop distances from ``s`` inside the vertices ``>= s``, up to ``reach`` hops.
+
+        Every vertex of a cycle of ``L`` edges through its smallest vertex ``s`` lies
+        within ``L // 2`` hops of ``s``, so that reach prunes the search exactly as the
+        whole breadth-first tree would, at a cost bounded by the ball, not the graph.
+        """
+        d = {s: 0}
+        q = deque([s])
+        while q:
+            x = q.popleft()
+            dx = d[x] + 1
+            if dx > reach:
+                continue
+            for y in self.nbrs[x]:
+                if y > s and y not in d:
+                    d[y] = dx
+                    q.append(y)
         return d
 
     def is_separating(self, vertices) -> bool:
@@ -512,7 +516,8 @@ class CandidatePool:
         return edges, verts
 
     def _raw_cycles_python(self, L: int):
-        found = simple_cycles(self.adj, L, self._dist_from, self.work, self.max_work)
+        found = simple_cycles(self.adj, L, lambda s: self._dist_from(s, L // 2), self.work,
+                              self.max_work)
         self.work = found[2]
         if found[0] is None:
             self.work_bound_hit = True
