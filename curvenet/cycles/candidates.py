@@ -134,8 +134,9 @@ class Candidate:
 class CandidatePool:
     """Candidate cycles of a network, enumerated length by length (Algorithm 1).
 
-    Precomputes adjacency and per-edge geometric moments once; :meth:`cycles_of_length` then enumerates and weighs all simple
-    cycles of one length, each exactly once.
+    Precomputes adjacency and per-edge geometric moments once;
+    :meth:`cycles_of_length` then enumerates and weighs all simple cycles of one
+    length, each exactly once.
 
     Parameters
     ----------
