@@ -14,7 +14,7 @@ import numpy as np
 
 from .tolerances import ZERO_LENGTH
 
-__all__ = ["Polylines", "row_norms"]
+__all__ = ["Polylines", "row_norms", "row_dots"]
 
 #: Largest ``points x queries`` comparison array built at once (bounds the memory).
 _CHUNK = 4_000_000
@@ -110,6 +110,27 @@ class Polylines:
             out[ids] = got
         return out if out is not None else np.zeros((0, t.shape[1], 0))
 
+    def interp(self, x) -> np.ndarray:
+        """Points at arc-length parameters as :func:`numpy.interp` gives them per coordinate
+        (``np.interp(x, cum, points[:, k])``), which rounds differently from :meth:`at`.
+
+        Parameters
+        ----------
+        x : (K, k) float64
+
+        Returns
+        -------
+        (K, k, d) float64
+        """
+        x = np.asarray(x, dtype=np.float64)
+        out = None
+        for ids, pts, cum in self.groups:
+            got = _interp(pts, cum, x[ids])
+            if out is None:
+                out = np.empty((len(x), x.shape[1], pts.shape[2]))
+            out[ids] = got
+        return out if out is not None else np.zeros((0, x.shape[1], 0))
+
 
 def row_norms(v) -> np.ndarray:
     """Euclidean norm of each row, ``(n,) float64``, as :func:`numpy.linalg.norm` takes it
@@ -120,20 +141,55 @@ def row_norms(v) -> np.ndarray:
     ----------
     v : (n, d) float64
     """
-    v = np.asarray(v, dtype=np.float64)
-    return np.sqrt(np.matmul(v[:, None, :], v[:, :, None])[:, 0, 0])
+    return np.sqrt(row_dots(v, v))
+
+
+def row_dots(u, v) -> np.ndarray:
+    """``u[i] @ v[i]`` for each row, ``(n,) float64``, as ``@`` takes it of two vectors.
+
+    Parameters
+    ----------
+    u, v : (n, d) float64
+    """
+    u, v = np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64)
+    return np.matmul(u[:, None, :], v[:, :, None])[:, 0, 0]
+
+
+def _interp(pts, cum, x):
+    """Rows of :func:`numpy.interp` (its cases and arithmetic): ``pts (g, m, d)``,
+    ``cum (g, m)`` non-decreasing, ``x (g, k)``."""
+    g, m = cum.shape
+    j = _last_at_or_below(cum, x)                                # -1 .. m - 1
+    jc = np.clip(j, 0, m - 2)
+    row = np.arange(g)[:, None]
+    x0, x1 = cum[row, jc][..., None], cum[row, jc + 1][..., None]
+    y0, y1 = pts[row, jc], pts[row, jc + 1]
+    xv = x[..., None]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        slope = (y1 - y0) / (x1 - x0)
+        res = slope * (xv - x0) + y0
+        other = slope * (xv - x1) + y1                           # numpy's retry after a NaN
+    res = np.where(np.isnan(res), np.where(np.isnan(other) & (y0 == y1), y0, other), res)
+    res = np.where((x0 == xv) & (j >= 0)[..., None], y0, res)   # at a knot: its value
+    res = np.where((j < 0)[..., None], pts[:, :1], res)
+    return np.where((j >= m - 1)[..., None], pts[:, -1:], res)
+
+
+def _last_at_or_below(cum, x):
+    """``searchsorted(cum, x, side="right") - 1`` row by row: ``(g, k) int64``."""
+    g, m = cum.shape
+    j = np.empty(x.shape, np.int64)
+    step = max(1, _CHUNK // max(m * x.shape[1], 1))
+    for lo in range(0, g, step):
+        j[lo:lo + step] = (cum[lo:lo + step, :, None] <= x[lo:lo + step, None, :]).sum(axis=1) - 1
+    return j
 
 
 def _interpolate(pts, cum, s):
     """Rows of :func:`interpolate_polyline`: ``pts (g, m, d)``, ``cum (g, m)``, ``s (g, k)``."""
     g, m = cum.shape
     s = np.clip(s, cum[:, :1], cum[:, -1:])
-    j = np.empty(s.shape, np.int64)
-    step = max(1, _CHUNK // max(m * s.shape[1], 1))
-    for lo in range(0, g, step):
-        # searchsorted(cum, s, side="right") - 1, row by row
-        j[lo:lo + step] = (cum[lo:lo + step, :, None] <= s[lo:lo + step, None, :]).sum(axis=1) - 1
-    j = np.clip(j, 0, m - 2)
+    j = np.clip(_last_at_or_below(cum, s), 0, m - 2)
     row = np.arange(g)[:, None]
     c0, c1 = cum[row, j], cum[row, j + 1]
     seg = c1 - c0

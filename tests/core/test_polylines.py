@@ -47,3 +47,14 @@ def test_row_norms_are_the_norm_of_each_vector():
     rng = np.random.default_rng(4)
     v = rng.normal(size=(20_000, 3)) * 10.0 ** rng.uniform(-3, 3, (20_000, 1))
     assert row_norms(v).tolist() == [np.linalg.norm(x) for x in v]
+
+
+def test_interp_is_numpy_interp_per_coordinate(polylines):
+    cums = [cumulative_length(p) for p in polylines]
+    x = np.random.default_rng(5).uniform(-1, 60, (len(polylines), 5))
+    x[:, 0] = 0.0
+    x[:, 1] = [c[-1] for c in cums]                  # the last point, and a knot
+    x[:, 2] = [c[len(c) // 2] for c in cums]
+    want = [np.stack([np.interp(x[i], c, p[:, k]) for k in range(3)], axis=1)
+            for i, (p, c) in enumerate(zip(polylines, cums))]
+    assert np.array_equal(Polylines(polylines).interp(x), np.stack(want))
