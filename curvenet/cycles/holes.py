@@ -140,19 +140,33 @@ class _Planes:
     def __init__(self, network: CurveNetwork, patches, tol: float):
         pts = [loop_points(network, cycle_to_loop(network, p.edges)) for p in patches]
         n = len(pts)
-        self.start = np.concatenate([[0], np.cumsum([len(q) for q in pts])]).astype(np.int64)
+        sizes = np.array([len(q) for q in pts], np.int64)
+        self.start = np.concatenate([[0], np.cumsum(sizes)]).astype(np.int64)
         self.points = np.concatenate(pts)
         self.centre = np.empty((n, 3))
         self.normal = np.empty((n, 3))
         self.axes = np.empty((n, 2, 3))
-        self.planar = np.zeros(n, bool)
+        dev = np.empty(n)
+        order = np.argsort(sizes, kind="stable")
+        for ids in np.split(order, np.flatnonzero(np.diff(sizes[order])) + 1):
+            if len(ids) == 0:
+                continue
+            q = np.stack([pts[k] for k in ids])                            # (g, m, 3)
+            if q.shape[1] < 3:       # fit_plane completes the frame of one or two points
+                frames = [fit_plane(x) for x in q]
+                c = np.array([f[0] for f in frames])
+                nrm = np.array([f[1] for f in frames])
+                axes = np.array([f[2] for f in frames])
+            else:                    # fit_plane, loop by loop in the stacked SVD
+                c = q.mean(axis=1)
+                vt = np.linalg.svd(q - c[:, None], full_matrices=False)[2]
+                nrm, axes = vt[:, 2], vt[:, :2]
+            self.centre[ids], self.normal[ids], self.axes[ids] = c, nrm, axes
+            dev[ids] = np.abs(np.matmul(q - c[:, None], nrm[:, :, None])[..., 0]).max(axis=1)
+        self.planar = (dev <= tol) & np.array([not p.holes for p in patches], bool)
         self.area = np.zeros(n)
-        for k, (q, p) in enumerate(zip(pts, patches)):
-            c, nrm, axes = fit_plane(q)
-            self.centre[k], self.normal[k], self.axes[k] = c, nrm, axes
-            self.planar[k] = not p.holes and float(np.abs((q - c) @ nrm).max()) <= tol
-            if self.planar[k]:
-                self.area[k] = abs(_area2d((q - c) @ axes.T))
+        for k in np.flatnonzero(self.planar):
+            self.area[k] = abs(_area2d((pts[k] - self.centre[k]) @ self.axes[k].T))
         self.lo = np.minimum.reduceat(self.points, self.start[:-1])
         self.hi = np.maximum.reduceat(self.points, self.start[:-1])
 
@@ -262,4 +276,5 @@ def _outside_in(nearest: dict) -> list:
 
 def _area2d(xy) -> float:
     x, y = xy[:, 0], xy[:, 1]
-    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))
+    xn, yn = np.r_[x[1:], x[:1]], np.r_[y[1:], y[:1]]        # np.roll(., -1)
+    return 0.5 * float(np.dot(x, yn) - np.dot(y, xn))
