@@ -39,6 +39,7 @@ from ..core.errors import InvalidParameterError
 from .holes import hole_patches
 from .loops import cycle_to_loop, orient_patches
 from .rotation import embedded_faces
+from .seams import seam_patches
 from ..model.network import CurveNetwork
 from ..model.patchset import Patch, PatchSet
 
@@ -71,7 +72,8 @@ def _validate(network, mode, close, tie_break, max_cycle_length, max_work):
 def find_patches(network: CurveNetwork, *, mode: str = "auto", close: str = "auto",
                  tie_break: str = "pca",
                  max_cycle_length=None, max_work: int = DEFAULT_MAX_WORK,
-                 engine: str = "auto", genus_aware: bool = True, holes: bool = True) -> PatchSet:
+                 engine: str = "auto", genus_aware: bool = True, holes: bool = True,
+                 seams: bool = True) -> PatchSet:
     """Find surface patches: the faces of the surface the curves imply.
 
     Parameters
@@ -115,6 +117,10 @@ def find_patches(network: CurveNetwork, *, mode: str = "auto", close: str = "aut
         Make nested coplanar patches holes of the face around them
         (:func:`curvenet.cycles.holes.hole_patches`; beyond the paper, whose basis
         holds only simple cycles). ``False``: every patch is a disc.
+    seams : bool
+        Add the periodic faces bounded by two loops and a seam curve walked twice (a
+        bore wall drawn with one seam line; :func:`curvenet.cycles.seams.seam_patches`).
+        ``False``: seams stay unused curves.
 
     Returns
     -------
@@ -128,7 +134,8 @@ def find_patches(network: CurveNetwork, *, mode: str = "auto", close: str = "aut
         lists), ``tie_break``, ``close``, ``timings`` (``{"patches": seconds}``) and
         ``patch_stages`` (seconds for ``setup``, ``basis``, ``closing``) and
         ``holes`` (which loops became holes of which patch, see
-        :func:`curvenet.cycles.holes.hole_patches`).
+        :func:`curvenet.cycles.holes.hole_patches`) and ``seams`` (the periodic faces
+        added, see :func:`curvenet.cycles.seams.seam_patches`).
 
     Raises
     ------
@@ -197,6 +204,10 @@ def find_patches(network: CurveNetwork, *, mode: str = "auto", close: str = "aut
     ps.report["holes"] = []
     if holes:
         ps.patches, ps.report["holes"] = hole_patches(network, ps.patches)
+    ps.report["seams"] = []
+    if seams:
+        ps.patches, ps.report["seams"], ps.report["holes"] = seam_patches(
+            network, ps.patches, ps.report["holes"])
     ps.report["timings"] = {"patches": time.perf_counter() - t0}
     return ps
 
@@ -239,7 +250,7 @@ def _choose_faces(network, basis: PatchSet, pool, close: str, mode: str,
                      simple=int(np.count_nonzero(faces.simple)), genus=faces.genus,
                      defect=defect)
     clean = bool(faces.simple.all()) and not faces.report["conflicts"]
-    if patches and (mode == "faces" or clean and defect["faces"] < defect["basis"]
+    if patches and (mode == "faces" or clean and defect["faces"] <= defect["basis"]
                     and _covers(patches, basis.patches)):
         report = dict(basis.report, mode="faces",
                       closing_added=[list(p.edges) for p in patches if p.source == "closing"],
