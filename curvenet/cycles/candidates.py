@@ -442,7 +442,8 @@ class CandidatePool:
             return False
         e_out = np.array([e for e, _ in loop], np.int64)
         s_out = np.array([0 if f else 1 for _, f in loop], np.int64)
-        e_in, s_in = np.r_[e_out[-1:], e_out[:-1]], 1 - np.r_[s_out[-1:], s_out[:-1]]
+        e_in = np.concatenate([e_out[-1:], e_out[:-1]])
+        s_in = 1 - np.concatenate([s_out[-1:], s_out[:-1]])
         a_all = self._tangents[e_out, s_out]     # leaving each vertex along the loop
         p_all = self._tangents[e_in, s_in]       # leaving it back along the loop
         # a corner of the cycle (a @ p > -cos): faces have corners, handle rings do not

@@ -276,5 +276,5 @@ def _outside_in(nearest: dict) -> list:
 
 def _area2d(xy) -> float:
     x, y = xy[:, 0], xy[:, 1]
-    xn, yn = np.r_[x[1:], x[:1]], np.r_[y[1:], y[:1]]        # np.roll(., -1)
+    xn, yn = np.concatenate([x[1:], x[:1]]), np.concatenate([y[1:], y[:1]])   # np.roll(., -1)
     return 0.5 * float(np.dot(x, yn) - np.dot(y, xn))
