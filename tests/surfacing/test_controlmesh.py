@@ -185,3 +185,17 @@ def test_bad_loops_rejected():
         build_control_mesh([np.zeros((2, 3)) + [[0, 0, 0], [1, 0, 0]]], [[(3, True)]], 4)
     with pytest.raises(ValueError, match="curves\\[0\\]"):
         build_control_mesh([np.zeros((1, 3))], [[(0, True)]], 4)
+
+
+def test_vectorised_turning_is_the_per_curve_loop_bit_for_bit():
+    """Oracle: the one-curve :func:`_turning` / :func:`_turn_pieces` (issue 32)."""
+    from curvenet.surfacing.controlmesh import _turn_pieces, _turning, _turnings, _turns_pieces
+    rng = np.random.default_rng(3)
+    curves = [e.curve for e in shapes.torus().network.edges]
+    curves += [np.cumsum(rng.normal(size=(int(rng.integers(2, 80)), 3)), 0) for _ in range(200)]
+    curves += [np.zeros((4, 3)), np.array([[0.0, 0, 0], [0, 0, 0], [1, 0, 0]])]  # degenerate
+    for n in (8, 16, 24, 32):
+        loop = np.array([_turning(c, n) for c in curves])
+        assert np.array_equal(_turnings(curves, n), loop, equal_nan=True)
+    assert np.array_equal(_turns_pieces(curves), [_turn_pieces(c) for c in curves])
+    assert _turns_pieces(curves).max() > 1       # the random walks do ask for pieces
