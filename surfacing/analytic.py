@@ -354,12 +354,6 @@ REFINED_GUESSES = 2
 GUESS_SCREEN = 0.05
 #: Samples the refinement uses at most (evenly picked; the check uses all).
 REFINE_SAMPLES = 256
-#: A guess whose RMS distance exceeds this many tolerances is not refined. The algebraic
-#: guesses are exact on samples of their surface (every analytic face of the CAD shapes
-#: starts within 1e-10 tolerances), so the refinement only polishes a guess that is
-#: nearly there. On the free-form patches of ``benchmarks/bench_scale.py``'s curved
-#: networks it ran for 0.1 to 0.4 s a patch, in vain (issue 32).
-REFINE_SCREEN = 1.0
 
 
 def _refined(kind, p, guesses, tol):
@@ -369,8 +363,7 @@ def _refined(kind, p, guesses, tol):
         return
     ext = float(np.linalg.norm(np.ptp(p, axis=0)))
     rms = [float(np.sqrt(np.mean(_surface(kind, g).distance(p) ** 2))) for g in guesses]
-    order = [i for i in np.argsort(rms)[:REFINED_GUESSES]
-             if rms[i] <= min(GUESS_SCREEN * ext, REFINE_SCREEN * tol)]
+    order = [i for i in np.argsort(rms)[:REFINED_GUESSES] if rms[i] <= GUESS_SCREEN * ext]
     sub = p[np.linspace(0, len(p) - 1, min(len(p), REFINE_SAMPLES)).astype(int)]
     for i in order:
         x, _ = _refine(kind, guesses[i], sub)
