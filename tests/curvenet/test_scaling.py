@@ -1,11 +1,13 @@
 """Every stage scales about linearly with the network size (issue 32).
 
 Small-size counterpart of ``benchmarks/bench_scale.py``: the CPU seconds of reading,
-snapping, patch finding and the classical surface on grid boxes and dense curved
-networks of about 100 to 450 curves, with the exponent ``k`` of ``cpu ~ curves^k``
-fitted on log-log axes. A stage with a pair loop over patches or curves shows
-``k`` near 2 already at these sizes (the hole search of issue 31 measured 2.1 from
-192 to 972 curves); linear stages with a fixed overhead measure under 1.
+snapping, patch finding and (grid boxes only) the classical surface on grid boxes and
+dense curved networks of about 100 to 450 curves, with the exponent ``k`` of
+``cpu ~ curves^k`` fitted on log-log axes. A stage with a pair loop over patches or
+curves shows ``k`` near 2 already at these sizes (the hole search of issue 31 measures
+1.5 here); linear stages with a fixed overhead measure under 1. The dense networks'
+classical surface is left out for time: its analytic-face fit costs about 0.1 s a
+patch (benchmarks/README.md).
 """
 
 from __future__ import annotations
@@ -38,19 +40,21 @@ def _cpu(fn, repeats=1):
     return best, out
 
 
-def _stages(sketch, path) -> dict:
+def _stages(sketch, path, with_surface) -> dict:
     write_sketch(path, sketch)
     out = {}
     out["read"], sk = _cpu(lambda: load_source(path)[0], 3)
     out["snap"], net = _cpu(lambda: snap(sk, snap_tol="auto"), 3)
     out["patches"], _ = _cpu(lambda: find_patches(net, close="auto"), 2)
-    out["surface"], _ = _cpu(lambda: surface(net, method="classical"))
+    if with_surface:
+        out["surface"], _ = _cpu(lambda: surface(net, method="classical"))
     return out
 
 
-def _exponents(make, tmp_path) -> dict:
-    _stages(make(2), tmp_path / "warm.obj")                 # imports, caches
-    rows = [(len(make(n).strokes), _stages(make(n), tmp_path / f"n{n}.obj")) for n in SIZES]
+def _exponents(make, tmp_path, with_surface) -> dict:
+    _stages(make(2), tmp_path / "warm.obj", with_surface)   # imports, caches
+    rows = [(len(make(n).strokes), _stages(make(n), tmp_path / f"n{n}.obj", with_surface))
+            for n in SIZES]
     curves = np.log([c for c, _ in rows])
     return {s: float(np.polyfit(curves, np.log([max(r[s], 1e-4) for _, r in rows]), 1)[0])
             for s in rows[0][1]}
@@ -59,9 +63,9 @@ def _exponents(make, tmp_path) -> dict:
 @pytest.mark.parametrize("family", ["grid", "dense"])
 def test_no_stage_grows_faster_than_curves_to_the_1_3(tmp_path, family):
     make = (lambda n: grid_box(n).sketch()) if family == "grid" else dense_blob
-    k = _exponents(make, tmp_path)
+    k = _exponents(make, tmp_path, with_surface=family == "grid")
     print(family, {s: round(v, 2) for s, v in k.items()})
-    assert set(k) == {"read", "snap", "patches", "surface"}
+    assert set(k) == {"read", "snap", "patches"} | ({"surface"} if family == "grid" else set())
     worst = {s: round(v, 2) for s, v in k.items() if v > MAX_EXPONENT}
     assert not worst, f"{family}: stages growing faster than curves^{MAX_EXPONENT}: {worst} ({k})"
 
