@@ -127,38 +127,21 @@ def _turnings(curves: list, n: int, params=None) -> np.ndarray:
     return turn.sum(1) * n / (n - 1)
 
 
-def _turn_pieces(curve: np.ndarray) -> int:
-    """Pieces a curve's turning asks for: the most any scale ``s`` (1 .. TURN_SCALES) asks.
-
-    At scale ``s`` the curve is resampled at ``TURN_SEGMENTS * s`` segments; when it turns
-    by more than ``PIECE_TURN * s`` there, ``s`` pieces cannot follow it and the scale asks
-    for ``ceil(turning / PIECE_TURN)``; otherwise it asks for nothing (coarser scales
-    decide whether fewer are enough). Stroke wobble below a piece's scale therefore adds
-    nothing to a curve that the coarse scales find smooth. :func:`_turns_pieces` is the
-    same for many curves at once.
-    """
-    need = 1
-    for s in range(1, TURN_SCALES + 1):
-        t = _turning(curve, TURN_SEGMENTS * s) / PIECE_TURN
-        if t > s * (1 + PIECE_ROUNDING):
-            need = max(need, int(np.ceil(t - PIECE_ROUNDING)))
-    return need
-
-
 def _turns_pieces(curves: list) -> np.ndarray:
-    """:func:`_turn_pieces` of every curve (``(C,) int64``), the scales vectorised."""
-    many = [k for k, c in enumerate(curves) if len(c) >= 2]
+    """Pieces each curve (``(m_i, 3)``, ``m_i >= 2``) asks for: ``(C,) int64``.
+
+    At scale ``s`` (1 .. TURN_SCALES) a curve is resampled at ``TURN_SEGMENTS * s``
+    segments; when it turns by more than ``PIECE_TURN * s`` there, ``s`` pieces cannot
+    follow it and the scale asks for ``ceil(turning / PIECE_TURN)``; otherwise it asks
+    for nothing (coarser scales decide whether fewer are enough). Stroke wobble below a
+    piece's scale therefore adds nothing to a curve that the coarse scales find smooth.
+    """
     need = np.ones(len(curves), np.int64)
-    for k in set(range(len(curves))) - set(many):
-        need[k] = _turn_pieces(curves[k])
-    group = [curves[k] for k in many]
-    params = [arc_length_params(c) for c in group]
+    params = [arc_length_params(c) for c in curves]
     for s in range(1, TURN_SCALES + 1):
-        t = _turnings(group, TURN_SEGMENTS * s, params) / PIECE_TURN
+        t = _turnings(curves, TURN_SEGMENTS * s, params) / PIECE_TURN
         over = t > s * (1 + PIECE_ROUNDING)
-        ask = np.ceil(t[over] - PIECE_ROUNDING).astype(np.int64)
-        idx = np.asarray(many, np.int64)[over]
-        need[idx] = np.maximum(need[idx], ask)
+        need[over] = np.maximum(need[over], np.ceil(t[over] - PIECE_ROUNDING).astype(np.int64))
     return need
 
 
@@ -167,7 +150,7 @@ def curve_pieces(curves: list, closed: np.ndarray) -> np.ndarray:
 
     ``max(1, ceil(length / (PIECE_LENGTH * median length)), turning pieces)``, at least 2
     for a closed curve; the turning pieces are what the curve's turning asks for at the
-    scales of one to :data:`TURN_SCALES` pieces (:func:`_turn_pieces`).
+    scales of one to :data:`TURN_SCALES` pieces (:func:`_turns_pieces`).
 
     Returns
     -------

@@ -188,8 +188,10 @@ def test_bad_loops_rejected():
 
 
 def test_vectorised_turning_is_the_per_curve_loop_bit_for_bit():
-    """Oracle: the one-curve :func:`_turning` / :func:`_turn_pieces` (issue 32)."""
-    from curvenet.surfacing.controlmesh import _turn_pieces, _turning, _turnings, _turns_pieces
+    """Oracle: the one-curve :func:`_turning` and a loop over scales (issue 32)."""
+    from curvenet.surfacing.controlmesh import (PIECE_ROUNDING, PIECE_TURN, TURN_SCALES,
+                                                TURN_SEGMENTS, _turning, _turnings,
+                                                _turns_pieces)
     rng = np.random.default_rng(3)
     curves = [e.curve for e in shapes.torus().network.edges]
     curves += [np.cumsum(rng.normal(size=(int(rng.integers(2, 80)), 3)), 0) for _ in range(200)]
@@ -197,5 +199,14 @@ def test_vectorised_turning_is_the_per_curve_loop_bit_for_bit():
     for n in (8, 16, 24, 32):
         loop = np.array([_turning(c, n) for c in curves])
         assert np.array_equal(_turnings(curves, n), loop, equal_nan=True)
-    assert np.array_equal(_turns_pieces(curves), [_turn_pieces(c) for c in curves])
-    assert _turns_pieces(curves).max() > 1       # the random walks do ask for pieces
+
+    def pieces(c):
+        need = 1
+        for s in range(1, TURN_SCALES + 1):
+            t = _turning(c, TURN_SEGMENTS * s) / PIECE_TURN
+            if t > s * (1 + PIECE_ROUNDING):
+                need = max(need, int(np.ceil(t - PIECE_ROUNDING)))
+        return need
+    got = _turns_pieces(curves)
+    assert np.array_equal(got, [pieces(c) for c in curves])
+    assert got.max() > 1                        # the random walks do ask for pieces
