@@ -79,7 +79,8 @@ def _rss() -> int:
 
 
 def run_stages(sketch: Sketch, folder, stages=STAGES, *, step_max: int = 2500) -> dict:
-    """Run the stages on one sketch; ``{stage: (wall s, cpu s, peak RSS bytes)}``.
+    """Run the stages on one sketch; ``{stage: (wall s, cpu s, peak RSS bytes)}``, and
+    ``"found"``: the number of patches found.
 
     The sketch is written to ``folder/net.obj`` first (not timed). Stages after a
     skipped one that they need are skipped too; ``step`` is skipped without
@@ -114,7 +115,9 @@ def run_stages(sketch: Sketch, folder, stages=STAGES, *, step_max: int = 2500) -
             pass
         else:
             timed("step", lambda: state["surface"].save(Path(folder) / "net.step"))
-    return {k: v for k, v in out.items() if k in need}
+    found = state.get("patches") or getattr(state.get("surface"), "patchset", None)
+    out["found"] = len(found.patches) if found is not None else 0
+    return {k: v for k, v in out.items() if k in need or k == "found"}
 
 
 def exponent(curves, seconds) -> float:
@@ -147,7 +150,7 @@ def main(argv=None) -> int:
                             if (s in res and (w, c, m) == res[s]) else f"{'-':>28}"
                             for s in stages for (w, c, m) in [res.get(s, (0, 0, 0))])
             print(f"{family + '(' + str(size) + ')':<18}{len(sk.strokes):>7}"
-                  f"{'':>8}  {cells}", flush=True)
+                  f"{res['found']:>8}  {cells}", flush=True)
             table.append((len(sk.strokes), res))
         fits = []
         for s in stages:
