@@ -30,8 +30,11 @@ $(VENV)/.installed: pyproject.toml $(VENV)/.torch
 	$(PIP) -e .
 	touch $@
 
-# [cluster] (dask.distributed, pure Python) runs the LocalCluster batch test; [cad]
-# (cadquery-ocp with vtk, ~1.1 GB) is left out: tests/curvenet/test_cad.py skips without it.
+# [cluster] (dask.distributed, pure Python) runs the LocalCluster batch test; [view]
+# (viser) and Playwright's client run curvenet review's page in a browser where one is
+# installed (best effort: without them those tests skip); [cad] (cadquery-ocp with vtk,
+# ~1.1 GB) is left out: tests/curvenet/test_cad.py skips without it.
 $(VENV)/.installed-test: pyproject.toml $(VENV)/.torch
 	$(PIP) -e '.[test,cluster]'
+	$(PIP) -e '.[view]' playwright || echo "no [view]/playwright: the browser tests skip"
 	touch $@

@@ -55,6 +55,16 @@ def _positive_int(text: str) -> int:
     return value
 
 
+def _port(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer: {text!r}") from None
+    if not 0 <= value <= 65535:
+        raise argparse.ArgumentTypeError(f"{text} is not a port (0..65535)")
+    return value
+
+
 def _edge_length(text: str) -> float:
     """``--edge-length``: a fraction of the diagonal in (0, 1]."""
     try:
@@ -123,6 +133,24 @@ def build_parser() -> argparse.ArgumentParser:
                    help="review patches: delete, accept/reject suggestions, undo, save")
     s.add_argument("--preview", metavar="PNG", help="write a picture of the patches")
     s.add_argument("--up", choices=("x", "y", "z"), default="z", help="up axis of the preview")
+
+    s = sub.add_parser("review", help="review the patches in the browser: click to accept or "
+                                      "reject, Save writes PATCHES.json (needs curvenet[view])")
+    s.add_argument("input", help="sketch file, NETWORK.json or PATCHES.json (reviewed as saved)")
+    s.add_argument("-o", "--output", metavar="PATCHES.json",
+                   help="the file Save writes (default: INPUT-stem.patches.json beside the "
+                        "input); nothing else is written")
+    s.add_argument("--port", type=_port, default=8080,
+                   help="port to serve on (default 8080; the next free one if taken; 0: any)")
+    s.add_argument("--host", default="127.0.0.1",
+                   help="address to bind (default 127.0.0.1: this machine only)")
+    s.add_argument("--no-browser", action="store_true", help="do not open a browser")
+    s.add_argument("--snap-tol", type=_snap_tol, default="auto",
+                   help="fraction of the bbox diagonal, or auto (default)")
+    s.add_argument("--close", choices=("auto", "none"), default="auto",
+                   help="accept solid-closing patches automatically (default auto)")
+    s.add_argument("--points", action="store_true", help=_POINTS_HELP)
+    s.add_argument("--up", choices=("x", "y", "z"), default="z", help="up axis of the view")
 
     s = sub.add_parser("surface", help="surface a sketch, network or patch set")
     s.add_argument("inputs", nargs="+", metavar="INPUT")
@@ -240,6 +268,30 @@ def _cmd_patches(args) -> int:
     return 0
 
 
+def _cmd_review(args) -> int:
+    from .pipeline import load_source, patches, surface
+    from .review.web import require_viser, serve_review
+    require_viser()                               # before any work: say which extra
+    stem = Path(args.input)
+    output = args.output or str(stem.with_name(stem.stem + ".patches.json"))
+    check_output_path(output, inputs=[args.input], what="-o")
+    sketch, given = load_source(args.input, points=_points(args))
+    ps = given if given is not None and given.patches else patches(
+        sketch if sketch is not None else given, snap_tol=args.snap_tol, close=args.close)
+    if not ps.patches:
+        raise CurvenetError(f"{args.input}: no patches found, nothing to review")
+
+    def surface_fn(patchset):
+        return surface(sketch if sketch is not None else patchset, patchset=patchset,
+                       method="classical").mesh
+
+    serve_review(dict(patchset=ps, output=output, inputs=[args.input],
+                      strokes=[] if sketch is None else sketch.strokes, surface=surface_fn,
+                      host=args.host, port=args.port, title=Path(args.input).name,
+                      up=args.up), open_browser=not args.no_browser)
+    return 0
+
+
 def _neural_options(args) -> dict | None:
     """``--neural-set`` overrides, with ``--closed-box`` as ``boundary="dirichlet"``."""
     options = dict(args.neural_set)
@@ -281,46 +333,6 @@ def _surface_one(inp: str, out: str, args) -> dict:
     except CurvenetError as err:
         return {"input": inp, "output": out, "status": "error", "error": _naming(err, inp),
                 "seconds": time.perf_counter() - t0}
-
-
-def _cad_lines(cad: dict) -> list:
-    """``--explain`` lines of a CAD export: pieces, file check, the worst seams."""
-    pr, fr = cad["pieces"], cad["file"]
-    kinds: dict = {}
-    for f in cad["faces"]:
-        kinds[f["kind"]] = kinds.get(f["kind"], 0) + 1
-    analytic = [f["residual"] for f in cad["faces"] if f["residual"] is not None]
-    lines = [f"cad: {len(cad['faces'])} faces ("
-             + ", ".join(f"{n} {k}" for k, n in sorted(kinds.items())) + ")"
-             + (f", largest analytic residual {max(analytic):.1e} of the diagonal"
-                if analytic else "")]
-    if kinds.get("bspline"):
-        lines.append(f"cad: B-spline faces: {pr['n_exact']} of {pr['n_pieces']} pieces exact "
-                     f"(level {pr['level']}, graded {max(pr['grades_used'], default=0)}), max "
-                     f"deviation {pr['max_deviation']:.2e} of the diagonal")
-    if "valid" in fr:
-        lines.append(f"cad: {fr['shells']} shells, {fr['solids']} solids, {fr['free_edges']} "
-                     f"free edges, valid {fr['valid']}, sewing tolerance "
-                     f"{cad['sew_tolerance']:.2e}")
-    else:
-        lines.append(f"cad: {fr['breps']} joined Breps, {fr['solids']} closed, valid "
-                     f"{fr['valid']}")
-    seams = cad["seams"]
-    smooth = [s for s in seams if not s["crease"]]
-    lines.append(f"cad: {len(seams)} seams ({len(seams) - len(smooth)} creases), largest G0 gap "
-                 f"{max((s['gap'] for s in seams), default=0.0):.1e} of the diagonal, largest "
-                 f"G1 angle off creases {max((s['angle'] for s in smooth), default=0.0):.2f} deg"
-                 f" ({max((s['corner_angle'] for s in smooth), default=0.0):.2f} at face "
-                 f"corners)")
-    for s in sorted(smooth, key=lambda s: -s["angle"])[:_SEAMS_SHOWN]:
-        lines.append(f"seam patches {s['patches'][0]}-{s['patches'][1]} curves {s['curves']}: "
-                     f"G0 {s['gap']:.1e}, G1 {s['angle']:.2f} deg, deviation "
-                     f"{s['deviation']:.1e}")
-    return lines
-
-
-#: Smooth seams listed by ``--explain`` (largest G1 angle first).
-_SEAMS_SHOWN = 10
 
 
 def _cmd_surface(args) -> int:
@@ -366,7 +378,8 @@ def _cmd_surface(args) -> int:
             from .core.fidelity import format_fidelity
             print(format_fidelity(row["fidelity"]))
         if row.get("cad"):
-            print("\n".join(_cad_lines(row["cad"])))
+            from .cad.report import cad_report_lines
+            print("\n".join(cad_report_lines(row["cad"])))
     return 130 if row["interrupted"] else 0
 
 
@@ -526,8 +539,8 @@ def _on_sigterm(handler):
         return None
 
 
-COMMANDS = {"snap": _cmd_snap, "patches": _cmd_patches, "surface": _cmd_surface,
-            "eval": _cmd_eval}
+COMMANDS = {"snap": _cmd_snap, "patches": _cmd_patches, "review": _cmd_review,
+            "surface": _cmd_surface, "eval": _cmd_eval}
 
 
 def main(argv=None) -> int:

@@ -470,7 +470,7 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
     method : str
         ``"auto"`` snaps, finds patches and takes the classical route when they cover at
         least :data:`AUTO_MIN_COVERAGE` of the curve length, else the neural route;
-        ``"classical"`` (the ``surfacer``), or any name of :func:`surfacers.surfacer_names`.
+        ``"classical"`` (the ``surfacer``), or any name of :func:`curvenet.route.surfacer_names`.
     patchset : PatchSet, optional
         Use these patches (e.g. an edited ``PATCHES.json``) instead of finding them.
     snap_tol : float or "auto"

@@ -103,7 +103,7 @@ class BatchOptions:
     @property
     def may_be_neural(self) -> bool:
         """Whether a file's route may be neural (such tasks ask Dask for a ``neural`` unit)."""
-        return self.method in ("auto", "neural") or self.refine
+        return self.method in ("auto", "neural", "hybrid") or self.refine
 
 
 @dataclass

@@ -50,16 +50,18 @@ def load_mesh_arrays(mesh, *, name: str = "mesh") -> tuple[np.ndarray, np.ndarra
         path = Path(mesh)
         import trimesh
 
+        kind = path.suffix.lstrip(".").upper() or "mesh"
         try:
             # process=False: trimesh's clean-up would drop NaN vertices before the check below
             loaded = trimesh.load(str(path), force="mesh", process=False)
         except Exception as err:  # trimesh raises many types (ValueError, KeyError, ...)
             # an ImportError here is trimesh guessing a text encoding, not a missing feature
             why = "" if isinstance(err, ImportError) else f" ({err})"
-            kind = path.suffix.lstrip(".").upper() or "mesh"
             raise SketchFormatError(f"not a readable {kind} mesh{why}", path=path) from None
         if not hasattr(loaded, "faces") or len(loaded.faces) == 0:
-            raise SketchFormatError("no triangles in mesh file", path=path)
+            # with charset_normalizer installed (requests brings it) trimesh reads
+            # garbage as an empty ASCII file instead of failing: name the format here too
+            raise SketchFormatError(f"no triangles in the {kind} mesh file", path=path)
         vertices, faces = loaded.vertices, loaded.faces
     elif hasattr(mesh, "vertices") and hasattr(mesh, "faces"):
         vertices, faces = mesh.vertices, mesh.faces

@@ -156,8 +156,11 @@ class PatchSession:
         return self.pool.cycle_rank
 
     def rank(self) -> int:
-        """GF(2) rank of the current patches (galois)."""
-        return gf2_rank([edge_mask(p.edges) for p in self._patches], self.network.number_of_edges)
+        """GF(2) rank of the current patches, by the session's ``backend``."""
+        masks = [edge_mask(p.edges) for p in self._patches]
+        if self.backend == "galois":
+            return gf2_rank(masks, self.network.number_of_edges)
+        return len(masks) - len(bitset_solve(masks, [])[1])   # minus the dependencies
 
     def _solve(self, targets):
         pm = [edge_mask(p.edges) for p in self._patches]
@@ -195,7 +198,10 @@ class PatchSession:
         if not cands:
             return []
         sols, _ = self._solve(cands)
-        free = [c for c, x in zip(cands, sols) if x is None]
+        return self._replacements([c for c, x in zip(cands, sols) if x is None], top)
+
+    def _replacements(self, free, top: int) -> list:
+        """Candidates outside the span as replacement suggestions, by Sec. 4.2 weight."""
         self.pool.classify(free)
         free.sort(key=lambda c: c.key)
         return [Suggestion(c.edges, "replacement", float(c.k), c.length,
@@ -209,6 +215,57 @@ class PatchSession:
         return [Suggestion(s["edges"], "closing", s["score"], s["size"],
                            {"a": s["a"], "b": s["b"], "solid": s["solid"]})
                 for s in out[:top]]
+
+    def alternatives_to(self, cycle, *, top: int = DEFAULT_TOP) -> list:
+        """Cycles through the same curves that could take a cycle's place, best first.
+
+        Parameters
+        ----------
+        cycle : int, Patch or sequence of int
+            An index into :attr:`patches`, or a cycle's edge ids (a current patch or
+            not, e.g. one the user took out).
+        top : int
+            Most suggestions returned.
+
+        Returns
+        -------
+        list of Suggestion
+            Candidates sharing at least one curve with ``cycle`` (never ``cycle``
+            itself, a current patch or a rejected one). Let ``R`` be the current
+            patches other than ``cycle``. When ``cycle`` is independent of ``R`` (a
+            basis patch), the replacements: candidates outside the span of ``R``, so
+            that ``R`` plus any one of them has the rank ``R`` plus ``cycle`` has, ranked
+            by the Sec. 4.2 weight (:meth:`replacement_suggestions`). When ``cycle``
+            is a sum of patches of ``R`` (it closes a solid), the closing patches of
+            ``R``, ranked by ``Ws`` (:meth:`closing_suggestions`); their ``solid`` indexes
+            :attr:`patches`.
+
+        Notes
+        -----
+        This is what :meth:`delete` would suggest after taking ``cycle`` out, kept to
+        "the next cycle through the same curves" (Sec. 5: the replacement is the
+        next-best patch), and it changes nothing: no history entry, nothing to undo.
+        """
+        if isinstance(cycle, (int, Patch)) and not isinstance(cycle, bool):
+            edges = self._patches[self._index(cycle)].edges
+        else:
+            edges = tuple(sorted(map(int, cycle)))
+        rest = [p for p in self._patches if p.edges != edges]
+        masks = [edge_mask(p.edges) for p in rest]
+        skip = {p.edges for p in self._patches} | self._rejected | {edges}
+        near = [c for c in self.pool.all_candidates
+                if c.edges not in skip and not set(c.edges).isdisjoint(edges)]
+        if bitset_solve(masks, [edge_mask(edges)])[0][0] is not None:
+            out = closing_suggestions(self.pool, [p.edges for p in rest], exclude=skip,
+                                      backend=self.backend, candidates=near)
+            where = [i for i, p in enumerate(self._patches) if p.edges != edges]
+            return [Suggestion(s["edges"], "closing", s["score"], s["size"],
+                               {"a": s["a"], "b": s["b"],
+                                "solid": [where[j] for j in s["solid"]]})
+                    for s in out[:top]]
+        sols = (gf2_solve(masks, [c.mask for c in near], self.network.number_of_edges)[0]
+                if self.backend == "galois" else bitset_solve(masks, [c.mask for c in near])[0])
+        return self._replacements([c for c, x in zip(near, sols) if x is None], top)
 
     # --- actions ------------------------------------------------------------------
     def delete(self, patch, *, top: int = DEFAULT_TOP) -> list:

@@ -36,15 +36,25 @@ def _ask(prompt, input, output) -> str | None:
 
 
 def _review(session, suggestions, input, output, preview) -> bool:
-    """Offer each suggestion: [a]ccept, [r]eject, [n]ext, [q]uit. False on end of input."""
+    """Offer each suggestion: [a]ccept, [r]eject, [n]ext, [q]uit. False on end of input.
+
+    A rejected suggestion is followed by its alternatives (the next cycles through the
+    same curves, :meth:`~curvenet.cycles.session.PatchSession.alternatives_to`) not
+    offered yet.
+    """
     if not suggestions:
         output.write("no suggestions\n")
         return True
-    for j, s in enumerate(suggestions):
-        output.write(f"  #{j + 1} {s.describe()}\n")
+    queue = list(suggestions)
+    offered = {s.edges for s in queue}
+    j = 0
+    while j < len(queue):
+        s = queue[j]
+        j += 1
+        output.write(f"  #{j} {s.describe()}\n")
         if preview:
             render_preview(preview, network=session.network, patches=session.patches,
-                           highlight=[list(s.edges)], title=f"{s.kind} #{j + 1}")
+                           highlight=[list(s.edges)], title=f"{s.kind} #{j}")
             output.write(f"  preview: {preview}\n")
         ans = _ask("  [a]ccept [r]eject [n]ext [q]uit > ", input, output)
         if ans is None:
@@ -56,7 +66,11 @@ def _review(session, suggestions, input, output, preview) -> bool:
             return True
         if key == "r":
             session.reject(s)
-            output.write("  rejected\n")
+            alts = [a for a in session.alternatives_to(s.edges) if a.edges not in offered]
+            offered |= {a.edges for a in alts}
+            queue[j:j] = alts
+            output.write(f"  rejected; {len(alts)} alternatives through its curves next\n"
+                         if alts else "  rejected\n")
         elif key == "q":
             return True
     return True
@@ -84,10 +98,12 @@ def run_interactive(patchset: PatchSet, *, input=sys.stdin, output=sys.stdout, p
 
     Notes
     -----
-    Main prompt keys: ``l`` list, ``d`` delete (then the patch number), ``c``
+    Main prompt keys: ``l`` list, ``d`` delete (then the patch number; the cycles
+    through its curves that could take its place are offered first), ``c``
     closing suggestions, ``r`` replacement suggestions, ``u`` undo, ``s`` save
     (then a path), ``q`` quit, ``h`` help. Each suggestion is answered with
-    ``a`` accept, ``r`` reject, ``n`` next, ``q`` back to the main prompt.
+    ``a`` accept, ``r`` reject (its alternatives through the same curves are offered
+    next), ``n`` next, ``q`` back to the main prompt.
     """
     session = PatchSession(patchset, backend=backend)
     output.write(f"{len(session.patches)} patches, rank {session.rank()} of "
@@ -107,12 +123,13 @@ def run_interactive(patchset: PatchSet, *, input=sys.stdin, output=sys.stdout, p
             if arg is None:
                 break
             try:
+                alts = session.alternatives_to(int(arg))
                 sugg = session.delete(int(arg))
             except (ValueError, InvalidParameterError) as err:
                 output.write(f"  cannot delete {arg!r}: {err}\n")
                 continue
             output.write(f"  deleted; rank {session.rank()} of {session.full_rank}\n")
-            if not _review(session, sugg, input, output, preview):
+            if not _review(session, alts or sugg, input, output, preview):
                 break
         elif key == "c":
             if not _review(session, session.closing_suggestions(), input, output, preview):

@@ -65,13 +65,29 @@ def contact_sheet(path, rows, tiles_dir, *, title: str | None = None) -> Path:
     """
     if not rows:
         raise InvalidParameterError("contact_sheet: no rows")
+    fig = _sheet(rows, tiles_dir, title)
+    path = Path(path)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, format="png", dpi=100, facecolor="white")
+    return path
+
+
+def _sheet(rows, tiles_dir, title):
+    """The contact sheet's Figure (Agg canvas).
+
+    Laid out by matplotlib's constrained layout, which measures the title and every
+    caption: the title sits above the first row's captions, each caption above its
+    tile, whatever their number of lines.
+    """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     from matplotlib.image import imread
 
     cols = min(MAX_COLUMNS, len(rows))
     nrows = math.ceil(len(rows) / cols)
-    fig = Figure(figsize=(TILE_INCHES[0] * cols, TILE_INCHES[1] * nrows + 0.5), dpi=100)
+    fig = Figure(figsize=(TILE_INCHES[0] * cols, TILE_INCHES[1] * nrows + 0.5), dpi=100,
+                 layout="constrained")
+    fig.get_layout_engine().set(w_pad=0.02, h_pad=0.04, wspace=0.02, hspace=0.04)
     FigureCanvasAgg(fig)
     counts: dict = {}
     for k, row in enumerate(rows):
@@ -89,9 +105,4 @@ def contact_sheet(path, rows, tiles_dir, *, title: str | None = None) -> Path:
         ax.set_title(_caption(row), fontsize=7, color=_colour(key))
     fig.suptitle(title or ", ".join(f"{v} {k}" for k, v in sorted(counts.items())),
                  fontsize=10)
-    fig.subplots_adjust(left=0.01, right=0.99, bottom=0.01, top=1 - 0.45 / fig.get_figheight(),
-                        wspace=0.05, hspace=0.35)
-    path = Path(path)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, format="png", dpi=100, facecolor="white")
-    return path
+    return fig

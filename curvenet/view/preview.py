@@ -16,14 +16,21 @@ import numpy as np
 from ..core.atomic import atomic_path
 from ..core.errors import InvalidParameterError
 from ..core.geometry import as_polyline
-from ..core.tolerances import COINCIDENT_REL, DIVISION_GUARD, ZERO_LENGTH
-from .colours import ROUTE_COLOURS, WIRE_COLOUR
+from ..core.tolerances import DIVISION_GUARD, ZERO_LENGTH
+from .decimate import decimate_clustering
+from .colours import (CURVE_COLOURS, HIGHLIGHT_COLOUR, ROUTE_COLOURS, WIRE_COLOUR,
+                      patch_colours)
 
 __all__ = ["render_preview", "patch_polygons", "decimate_clustering", "DEFAULT_VIEWS",
            "MAX_PREVIEW_FACES"]
 
-#: Default camera(s): ``(elevation, azimuth)`` in degrees, one panel each (front and back).
-DEFAULT_VIEWS = ((20.0, -60.0), (20.0, 120.0))
+#: Default cameras: ``(elevation, azimuth)`` in degrees, one panel each: front and back.
+#: The back camera is the front one's antipode (azimuth 180 degrees on, elevation
+#: negated), so the two look along opposite directions: every face that a convex shape
+#: turns away from one camera faces the other, and the pair shows each face once
+#: (the bottom too, where a missing patch hides). Two cameras both above, 180 degrees
+#: apart, see the same top twice and read as nearly the same picture.
+DEFAULT_VIEWS = ((20.0, -60.0), (-20.0, 120.0))
 
 #: Meshes with more faces are decimated (vertex clustering) before drawing.
 MAX_PREVIEW_FACES = 60_000
@@ -31,8 +38,11 @@ MAX_PREVIEW_FACES = 60_000
 #: Patch fans are cut into this many rings (smaller pieces sort better in depth).
 FAN_RINGS = 4
 
-#: Camera zoom of each panel (matplotlib leaves room for the hidden axes at 1.0).
-ZOOM = 1.1
+#: Share of a panel's width and height that the shape's projected bounding box fills
+#: (the rest is margin): the camera zoom is chosen per panel to fit it.
+FILL = 0.92
+#: Measure-and-correct passes of the fit (the second one only tidies rounding).
+FIT_PASSES = 2
 
 #: Lambert shading: ``AMBIENT + (1 - AMBIENT) * |n . l|`` (two-sided: orientation-agnostic);
 #: highlighted patches use the larger HIGHLIGHT_AMBIENT so they stay bright.
@@ -46,11 +56,7 @@ _UP = {"z": ((1, 0, 0), (0, 1, 0), (0, 0, 1)),
 
 _STROKE_COLOUR = (0.25, 0.25, 0.25)
 _CONSTRUCTION_COLOUR = (0.65, 0.65, 0.65)
-_EDGE_COLOURS = {"boundary": (0.12, 0.23, 0.45), "crease": (0.75, 0.22, 0.17)}
 _MESH_COLOUR = np.array([0.72, 0.76, 0.82])
-#: Highlight (a suggested patch): saturated orange, not produced by the patch palette
-#: (its saturation is 0.45), so tests can find it in the picture.
-HIGHLIGHT_COLOUR = (1.0, 0.45, 0.0)
 
 
 # ---------------------------------------------------------------------------
@@ -129,67 +135,6 @@ def _fan(polygon, rings: int = 1):
     return np.concatenate([inner, quads])
 
 
-def decimate_clustering(vertices, faces, max_faces: int, *, return_index: bool = False):
-    """Reduce a triangle mesh to at most ``max_faces`` faces by vertex clustering.
-
-    Parameters
-    ----------
-    vertices : (V, 3) float64
-    faces : (F, 3) int64
-    max_faces : int
-    return_index : bool
-        Also return the input face each output face comes from.
-
-    Returns
-    -------
-    vertices : (V', 3) float64
-    faces : (F', 3) int64
-        ``F' <= max_faces``; unchanged input when ``F <= max_faces``.
-    index : (F',) int64
-        Only with ``return_index``: the input face of each output face.
-
-    Notes
-    -----
-    Vertices are merged per cell of a uniform grid (Rossignac & Borrel 1993) placed at
-    the bounding-box minimum; the merged vertex is the cell's mean. Faces that collapse
-    (two corners in one cell) are dropped, duplicates kept once; orientation is kept.
-    The cell size starts at ``sqrt(2 A / max_faces)`` (a surface of area ``A`` meshed
-    at spacing ``h`` has about ``2 A / h^2`` triangles) and grows until the count fits.
-    Good enough for a picture, not for geometry processing.
-    """
-    v = np.asarray(vertices, dtype=np.float64)
-    f = np.asarray(faces, dtype=np.int64)
-    if len(f) <= max_faces:
-        return (v, f, np.arange(len(f))) if return_index else (v, f)
-    tri = v[f]
-    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]),
-                                axis=1).sum()
-    lo = v.min(axis=0)
-    diag = float(np.linalg.norm(np.ptp(v, axis=0)))
-    h = max(np.sqrt(2.0 * area / max_faces), COINCIDENT_REL * diag)
-    for _ in range(20):
-        keys = np.floor((v - lo) / h).astype(np.int64)  # (V, 3)
-        _, inverse = np.unique(keys, axis=0, return_inverse=True)
-        inverse = inverse.ravel()
-        nf = inverse[f]  # (F, 3)
-        ok = (nf[:, 0] != nf[:, 1]) & (nf[:, 1] != nf[:, 2]) & (nf[:, 0] != nf[:, 2])
-        nf = nf[ok]
-        # drop duplicate triangles (same corners, any rotation or orientation)
-        _, first = np.unique(np.sort(nf, axis=1), axis=0, return_index=True)
-        index = np.flatnonzero(ok)[np.sort(first)]
-        nf = nf[np.sort(first)]
-        if len(nf) <= max_faces:
-            break
-        h *= 1.05 * np.sqrt(len(nf) / max_faces)
-    count = np.bincount(inverse).astype(np.float64)
-    nv = np.stack([np.bincount(inverse, weights=v[:, k]) for k in range(3)], axis=1)
-    nv /= count[:, None]
-    used, nf = np.unique(nf, return_inverse=True)
-    if return_index:
-        return nv[used], nf.reshape(-1, 3), index
-    return nv[used], nf.reshape(-1, 3)
-
-
 def _light(elev, azim):
     """Unit key-light direction for a camera at ``(elev, azim)``: above-left of the eye."""
     e, a = np.radians(elev + 25.0), np.radians(azim - 30.0)
@@ -205,14 +150,6 @@ def _shade(triangles, base, light, ambient=AMBIENT):
     n /= np.maximum(np.linalg.norm(n, axis=1), DIVISION_GUARD)[:, None]
     lam = ambient + (1.0 - ambient) * np.abs(n @ light)
     return np.clip(np.asarray(base, dtype=np.float64).reshape(-1, 3) * lam[:, None], 0, 1)
-
-
-def _palette(k):
-    """``k`` distinct RGB colours: golden-ratio hue steps at saturation 0.45."""
-    from matplotlib.colors import hsv_to_rgb
-
-    hues = (0.1 + 0.618033988749895 * np.arange(k)) % 1.0
-    return hsv_to_rgb(np.column_stack([hues, np.full(k, 0.45), np.full(k, 0.95)]))
 
 
 # ---------------------------------------------------------------------------
@@ -415,7 +352,7 @@ def _patch_fans(network, edge_sets, hl_index, hl_extra):
         One entry per polygon.
     """
     fill = [(edges, HIGHLIGHT_COLOUR if i in hl_index else colour)
-            for i, (edges, colour) in enumerate(zip(edge_sets, _palette(len(edge_sets))))]
+            for i, (edges, colour) in enumerate(zip(edge_sets, patch_colours(len(edge_sets))))]
     fill += [(edges, HIGHLIGHT_COLOUR) for edges in hl_extra]
     tris, rgb, amb = [], [], []
     for edges, colour in fill:
@@ -452,13 +389,24 @@ def _preview_mesh(mesh, face_route, routes):
     return v, f, table[route[index]].reshape(-1, 3)
 
 
-def _legend(fig, routes, wires: bool) -> None:
-    """Route names (and "wires") in their colours along the picture's bottom edge."""
-    names = [(r, ROUTE_COLOURS.get(r, _MESH_COLOUR)) for r in routes]
+def _legend(fig, routes, wires: bool):
+    """Route names (and "wires") in their colours along the picture's bottom edge.
+
+    One matplotlib legend, its entries in a row: matplotlib measures each label, so the
+    swatches and names never overlap, at any picture width. Returns the Legend (None
+    when there is nothing to name).
+    """
+    from matplotlib.patches import Patch as Swatch
+
+    names = [(str(r), ROUTE_COLOURS.get(r, _MESH_COLOUR)) for r in routes]
     names += [("wires", WIRE_COLOUR)] if wires else []
-    for k, (name, colour) in enumerate(names):
-        fig.text(0.01 + 0.12 * k, 0.01, "\u25a0 " + name, color=colour, fontsize=10,
-                 fontweight="bold")
+    if not names:
+        return None
+    return fig.legend(handles=[Swatch(facecolor=c, label=n) for n, c in names],
+                      loc="lower left", ncols=len(names), frameon=False,
+                      labelcolor=[c for _, c in names], handlelength=1.0,
+                      handleheight=1.0, handletextpad=0.4, columnspacing=1.2,
+                      borderaxespad=0.3, prop={"weight": "bold", "size": 9})
 
 
 @dataclass
@@ -486,7 +434,7 @@ class _Scene:
         """Rotate by ``rot`` (3, 3) and bound; raises when there is nothing to draw."""
         net_curves = [] if network is None else [e.curve for e in network.edges]
         net_colours = [] if network is None else [
-            _EDGE_COLOURS.get(e.label, _EDGE_COLOURS["boundary"]) for e in network.edges]
+            CURVE_COLOURS.get(e.label, CURVE_COLOURS["boundary"]) for e in network.edges]
         net_pos = (np.zeros((0, 3)) if network is None or not net_curves
                    else network.positions)
         lines = [x @ rot for x in lines]
@@ -521,14 +469,18 @@ def _figure(scene: _Scene, views, width: int, height: int, title):
     fig = Figure(figsize=(width / 100.0, height / 100.0), dpi=100)
     FigureCanvasAgg(fig)
     fig.patch.set_facecolor("white")
+    axes = []
     for i, (elev, azim) in enumerate(views):
         ax = fig.add_subplot(1, len(views), i + 1, projection="3d")
         ax.computed_zorder = False  # our zorder: surfaces, then curves on top
-        _draw_panel(ax, scene, _light(elev, azim))
         _frame(ax, scene.lo, scene.hi, elev, azim)
+        axes.append(ax)
     if title:
         fig.suptitle(str(title), fontsize=11)
     fig.subplots_adjust(left=0, right=1, bottom=0, top=0.94 if title else 1, wspace=0)
+    _fit(fig, axes, scene.lo, scene.hi)     # on the empty panels: a cheap draw
+    for ax, (elev, azim) in zip(axes, views):
+        _draw_panel(ax, scene, _light(elev, azim))
     return fig
 
 
@@ -563,15 +515,61 @@ def _draw_panel(ax, scene: _Scene, light):
                                              linewidths=3.0, zorder=7))
 
 
-def _frame(ax, lo, hi, elev, azim):
-    """Equal aspect around the data's bounding box, axes hidden, camera set."""
-    centre = 0.5 * (lo + hi)
+def _box(lo, hi):
+    """The drawn box ``(centre, extent)``: the bounds, a flat side kept 2% thick."""
     ext = hi - lo
     big = max(float(ext.max()), ZERO_LENGTH)
-    ext = np.maximum(ext, 0.02 * big)  # flat data keeps a thin box
+    return 0.5 * (lo + hi), np.maximum(ext, 0.02 * big)
+
+
+def _frame(ax, lo, hi, elev, azim):
+    """Equal aspect around the data's bounding box, axes hidden, orthographic camera set."""
+    centre, ext = _box(lo, hi)
     ax.set_xlim(centre[0] - ext[0] / 2, centre[0] + ext[0] / 2)
     ax.set_ylim(centre[1] - ext[1] / 2, centre[1] + ext[1] / 2)
     ax.set_zlim(centre[2] - ext[2] / 2, centre[2] + ext[2] / 2)
-    ax.set_box_aspect(tuple(ext), zoom=ZOOM)
+    ax.set_box_aspect(tuple(ext))
+    ax.set_proj_type("ortho")
     ax.view_init(elev=elev, azim=azim)
     ax.set_axis_off()
+
+
+def _fit(fig, axes, lo, hi) -> None:
+    """Zoom each panel so that the bounding box's projection fills :data:`FILL` of it.
+
+    matplotlib sizes a 3D panel for its (hidden) axes box seen from any side, so a long
+    shape seen along its diagonal overflows a narrow panel while a compact one floats
+    small. Under the orthographic camera the projection scales linearly with the zoom:
+    one measurement of the eight corners per panel gives the zoom exactly.
+    """
+    from mpl_toolkits.mplot3d import proj3d
+
+    centre, ext = _box(lo, hi)
+    corners = centre + ext * (np.indices((2, 2, 2)).reshape(3, -1).T - 0.5)  # (8, 3)
+    fw, fh = fig.get_size_inches()
+    panels = [ax.get_subplotspec().get_position(fig) for ax in axes]
+    for ax, pb in zip(axes, panels):
+        # a 3D panel draws in a square: make it the panel's longer side, centred on it
+        side = max(pb.width * fw, pb.height * fh)
+        ax.set_position([pb.x0 + pb.width / 2 - side / fw / 2,
+                         pb.y0 + pb.height / 2 - side / fh / 2, side / fw, side / fh])
+        ax.patch.set_visible(False)         # squares overlap: none may paint over another
+    zoom = [1.0] * len(axes)
+    for _ in range(FIT_PASSES):
+        fig.draw_without_rendering()
+        for i, (ax, pb) in enumerate(zip(axes, panels)):
+            x, y, _ = proj3d.proj_transform(*corners.T, ax.get_proj())
+            px = ax.transData.transform(np.column_stack([x, y]))       # (8, 2) pixels
+            size = np.maximum(np.ptp(px, axis=0), 1.0)
+            box = pb.transformed(fig.transFigure)
+            scale = FILL * min(box.width / size[0], box.height / size[1])
+            zoom[i] *= scale
+            ax.set_box_aspect(tuple(ext), zoom=zoom[i])
+            # the projection scales about the axes' centre: move the axes so that the
+            # projection's centre lands on the panel's
+            a = np.array([ax.bbox.x0 + ax.bbox.x1, ax.bbox.y0 + ax.bbox.y1]) / 2
+            d = (px.min(axis=0) + px.max(axis=0)) / 2 - a
+            shift = np.array([box.x0 + box.x1, box.y0 + box.y1]) / 2 - d * scale - a
+            pos = ax.get_position()
+            ax.set_position([pos.x0 + shift[0] / fig.bbox.width,
+                             pos.y0 + shift[1] / fig.bbox.height, pos.width, pos.height])

@@ -218,3 +218,80 @@ def test_decimation_index_names_the_source_faces():
     assert moved.max() < 0.15
     _v, small_f, same = decimate_clustering(m.vertices, m.faces[:50], 2000, return_index=True)
     np.testing.assert_array_equal(same, np.arange(50))
+
+
+def _panels(img, n):
+    w = img.shape[1] // n
+    return [img[:, k * w:(k + 1) * w] for k in range(n)]
+
+
+@pytest.mark.parametrize("size", [(900, 700), (400, 700), (1400, 300)])
+@pytest.mark.parametrize("shape", ["l_prism", "long_bar"])
+def test_the_whole_shape_is_in_every_panel(tmp_path, shape, size):
+    # background along all four borders of each panel: nothing is cut off, for any aspect
+    from curvenet.datasets import shapes
+
+    s = shapes.l_prism() if shape == "l_prism" else shapes.grid_box(1, size=(10, 1, 0.5))
+    img = read_png(render_preview(tmp_path / "p.png", patches=true_patchset(s), size=size))
+    for panel in _panels(img, 2):
+        ink = non_white(panel)
+        assert ink.mean() > 0.01                                  # the shape is drawn
+        for border in (ink[0], ink[-1], ink[:, 0], ink[:, -1]):
+            assert not border.any()
+        # and it fills the panel: its picture spans most of the width or the height
+        rows, cols = np.flatnonzero(ink.any(axis=1)), np.flatnonzero(ink.any(axis=0))
+        assert max(np.ptp(cols) / panel.shape[1], np.ptp(rows) / panel.shape[0]) > 0.6
+
+
+def test_default_views_are_front_and_back(tmp_path):
+    from curvenet.datasets import shapes
+    from curvenet.view.preview import DEFAULT_VIEWS
+
+    (e1, a1), (e2, a2) = DEFAULT_VIEWS
+    assert (a2 - a1) % 360 == 180 and e2 == -e1            # antipodal cameras
+    # the L-prism's top face is seen by the front camera only, its bottom by the back
+    s = shapes.l_prism()
+    ps = true_patchset(s)
+    z = [np.mean([s.network.edges[e].curve[:, 2].mean() for e in p.edges]) for p in ps.patches]
+    for face, seen_by in ((int(np.argmax(z)), 0), (int(np.argmin(z)), 1)):
+        img = read_png(render_preview(tmp_path / "v.png", patches=ps, highlight=[face]))
+        counts = [_orange(p).sum() for p in _panels(img, 2)]
+        # the outline is drawn over everything in both; the fill only where the face shows
+        assert counts[seen_by] > 5 * counts[1 - seen_by], counts
+
+
+def _orange(img):
+    """The highlight's hue at full saturation, however shaded."""
+    from matplotlib.colors import rgb_to_hsv
+
+    hsv = rgb_to_hsv(img)
+    return (np.abs(hsv[..., 0] - 0.075) < 0.02) & (hsv[..., 1] > 0.9) & (hsv[..., 2] > 0.5)
+
+
+def _overlap(a, b) -> bool:
+    return a.x0 < b.x1 and b.x0 < a.x1 and a.y0 < b.y1 and b.y0 < a.y1
+
+
+@pytest.mark.parametrize("width", [360, 200, 900])
+def test_legend_entries_do_not_overlap_their_text(width):
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    from curvenet.view.preview import _legend
+
+    fig = Figure(figsize=(width / 100, 3.0), dpi=100)
+    FigureCanvasAgg(fig)
+    legend = _legend(fig, ("classical", "neural", "hybrid"), True)
+    renderer = fig.canvas.get_renderer()
+    fig.draw(renderer)
+    texts = [t.get_window_extent(renderer) for t in legend.get_texts()]
+    swatches = [h.get_window_extent(renderer) for h in legend.legend_handles]
+    assert [t.get_text() for t in legend.get_texts()] == ["classical", "neural", "hybrid",
+                                                         "wires"]
+    boxes = texts + swatches
+    for i, a in enumerate(boxes):
+        for b in boxes[i + 1:]:
+            assert not _overlap(a, b), (a, b)
+    for a, b in zip(swatches, texts):                     # each swatch left of its name
+        assert a.x1 <= b.x0
+    assert _legend(fig, (), False) is None

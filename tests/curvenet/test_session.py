@@ -92,8 +92,10 @@ def test_backends_agree(two_boxes):
     a = PatchSession(ps, backend="galois")
     b = PatchSession(ps, backend="bitset")
     assert [s.edges for s in a.closing_suggestions()] == [s.edges for s in b.closing_suggestions()]
+    assert a.rank() == b.rank() == a.full_rank                  # a basis: no solid closed
     a.delete(3)
     b.delete(3)
+    assert a.rank() == b.rank() == a.full_rank - 1
     assert [s.edges for s in a.replacement_suggestions()] \
         == [s.edges for s in b.replacement_suggestions()]
 
@@ -105,6 +107,55 @@ def test_replacements_restore_rank(two_boxes):
     base = [edge_mask(p.edges) for p in session.patches]
     for s in session.replacement_suggestions(top=50):
         assert gf2_rank(base + [edge_mask(s.edges)], n_edges) == session.full_rank
+
+
+def _shares_a_curve(a, b):
+    return not set(a).isdisjoint(b)
+
+
+@pytest.mark.parametrize("backend", ["galois", "bitset"])
+def test_alternatives_to_a_basis_patch_are_the_next_cycles_through_its_curves(two_boxes,
+                                                                            backend):
+    session = PatchSession(find_patches(two_boxes.network, close="none"), backend=backend)
+    n_edges = two_boxes.network.number_of_edges
+    before = edge_sets(session.patches)
+    face = session.patches[0].edges
+    alts = session.alternatives_to(0, top=50)
+    assert alts and all(s.kind == "replacement" for s in alts)
+    assert edge_sets(session.patches) == before and not session.undo()  # nothing changed
+    rest = [edge_mask(p.edges) for p in session.patches if p.edges != face]
+    for s in alts:
+        assert s.edges != face and s.edges not in before
+        assert _shares_a_curve(s.edges, face)
+        # the alternative takes the face's place: the rank is what it was
+        assert gf2_rank(rest + [edge_mask(s.edges)], n_edges) == session.full_rank
+    assert [s.score for s in alts] == sorted(s.score for s in alts)
+    # the same as delete's suggestions kept to the face's curves (another API path)
+    by_delete = [s.edges for s in session.delete(0, top=500) if _shares_a_curve(s.edges, face)]
+    assert [s.edges for s in alts] == by_delete[:len(alts)]
+    # once taken out, the face gets the same alternatives by its edges
+    assert [s.edges for s in session.alternatives_to(face, top=50)] == [s.edges for s in alts]
+
+
+def test_alternatives_to_a_closing_patch_close_the_solid(box):
+    # a box's face has no alternative: every other cycle through its curves folds onto a face
+    boxed = PatchSession(find_patches(box.network))
+    assert all(boxed.alternatives_to(i) == [] for i in range(6))
+    session = PatchSession(find_patches(shapes.latlong_sphere().network))  # a closed solid
+    face = session.patches[12].edges
+    alts = session.alternatives_to(face)
+    assert alts and all(s.kind == "closing" for s in alts)
+    for s in alts:
+        assert _shares_a_curve(s.edges, face) and s.edges != face
+        acc = edge_mask(s.edges)
+        for j in s.details["solid"]:                 # indexes session.patches, never the face
+            assert session.patches[j].edges != face
+            acc ^= edge_mask(session.patches[j].edges)
+        assert acc == 0
+    session.reject(alts[0])
+    assert alts[0].edges not in {s.edges for s in session.alternatives_to(face)}
+    with pytest.raises(InvalidParameterError):
+        session.alternatives_to(99)
 
 
 def test_reject_and_undo(box):
@@ -192,3 +243,21 @@ def test_interactive_preview_png(tmp_path, box):
     run_interactive(find_patches(box.network, close="none"), input=io.StringIO("c\nn\nq\nq\n"),
                     output=io.StringIO(), preview=png, backend="bitset")
     assert png.is_file() and png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_interactive_offers_the_cycles_through_a_rejected_patch(two_boxes):
+    # a wrong patch taken out: the first offered are the cycles through its curves that
+    # could take its place; a rejected offer is followed by the cycles through its own
+    ps0 = find_patches(two_boxes.network, close="none")
+    expected = PatchSession(ps0, backend="bitset").alternatives_to(0)
+    out = io.StringIO()
+    ps = run_interactive(ps0, input=io.StringIO("d 0\nr\na\nq\n"), output=out,
+                         backend="bitset")
+    text = out.getvalue()
+    assert f"#1 {expected[0].describe()}" in text
+    first, second = [line for line in text.splitlines() if line.lstrip().startswith("#")][:2]
+    rejected = set(expected[0].edges)
+    assert "alternatives through its curves next" in text
+    accepted = ps.patches[-1].edges
+    assert accepted != expected[0].edges and not rejected.isdisjoint(accepted)
+    assert str(list(accepted)) in second
