@@ -49,7 +49,7 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from .coons import coons_eval, coons_grid
-from curvenet.core.geometry import arc_length, resample_polyline
+from curvenet.core.geometry import arc_length, arc_length_params, resample_polyline
 from curvenet.core.tolerances import DIVISION_GUARD
 from .sides import DEFAULT_STRAIGHT_ANGLE, group_sides
 
@@ -87,20 +87,61 @@ def _turning(curve: np.ndarray, n: int) -> float:
                  * n / (n - 1))
 
 
-def _turn_pieces(curve: np.ndarray) -> int:
-    """Pieces a curve's turning asks for: the most any scale ``s`` (1 .. TURN_SCALES) asks.
+def _turnings(curves: list, n: int, params=None) -> np.ndarray:
+    """:func:`_turning` of many curves at once: ``(C,) float64``, bit for bit the same.
 
-    At scale ``s`` the curve is resampled at ``TURN_SEGMENTS * s`` segments; when it turns
-    by more than ``PIECE_TURN * s`` there, ``s`` pieces cannot follow it and the scale asks
-    for ``ceil(turning / PIECE_TURN)``; otherwise it asks for nothing (coarser scales
-    decide whether fewer are enough). Stroke wobble below a piece's scale therefore adds
-    nothing to a curve that the coarse scales find smooth.
+    Parameters
+    ----------
+    curves : list of (m_i, 3) float64, m_i >= 2
+    n : int
+        Segments of the resample.
+    params : list of (m_i,) float64, optional
+        :func:`~curvenet.core.geometry.arc_length_params` of each curve (computed when
+        not given; pass them to share them between calls).
+
+    Notes
+    -----
+    Every curve is resampled at the same ``n + 1`` parameters, so the resamples stack
+    into one ``(C, n + 1, 3)`` array; only the segment lookup (one ``searchsorted``)
+    runs per curve. The arithmetic is elementwise and the sums run along contiguous
+    last axes, as in :func:`~curvenet.core.geometry.interpolate_polyline` and
+    :func:`_turning`.
     """
-    need = 1
+    if not curves:
+        return np.zeros(0)
+    params = [arc_length_params(c) for c in curves] if params is None else params
+    s = np.linspace(0.0, 1.0, int(n) + 1)
+    sizes = np.array([len(c) for c in curves], np.int64)
+    start = np.cumsum(sizes) - sizes
+    j = np.stack([np.clip(np.searchsorted(cum, np.clip(s, cum[0], cum[-1]), side="right") - 1,
+                          0, len(cum) - 2) for cum in params]) + start[:, None]   # (C, n + 1)
+    lo = np.stack([np.clip(s, cum[0], cum[-1]) for cum in params])             # (C, n + 1)
+    cum, pts = np.concatenate(params), np.concatenate(curves)
+    seg = cum[j + 1] - cum[j]
+    t = np.where(seg > 0, (lo - cum[j]) / np.where(seg > 0, seg, 1.0), 0.0)
+    r = pts[j] + t[..., None] * (pts[j + 1] - pts[j])                           # (C, n + 1, 3)
+    r[:, 0], r[:, -1] = pts[start], pts[start + sizes - 1]
+    d = np.diff(r, axis=1)                                                      # (C, n, 3)
+    d /= np.maximum(np.linalg.norm(d, axis=2, keepdims=True), DIVISION_GUARD)
+    turn = np.degrees(np.arccos(np.clip((d[:, 1:] * d[:, :-1]).sum(2), -1, 1)))  # (C, n - 1)
+    return turn.sum(1) * n / (n - 1)
+
+
+def _turns_pieces(curves: list) -> np.ndarray:
+    """Pieces each curve (``(m_i, 3)``, ``m_i >= 2``) asks for: ``(C,) int64``.
+
+    At scale ``s`` (1 .. TURN_SCALES) a curve is resampled at ``TURN_SEGMENTS * s``
+    segments; when it turns by more than ``PIECE_TURN * s`` there, ``s`` pieces cannot
+    follow it and the scale asks for ``ceil(turning / PIECE_TURN)``; otherwise it asks
+    for nothing (coarser scales decide whether fewer are enough). Stroke wobble below a
+    piece's scale therefore adds nothing to a curve that the coarse scales find smooth.
+    """
+    need = np.ones(len(curves), np.int64)
+    params = [arc_length_params(c) for c in curves]
     for s in range(1, TURN_SCALES + 1):
-        t = _turning(curve, TURN_SEGMENTS * s) / PIECE_TURN
-        if t > s * (1 + PIECE_ROUNDING):
-            need = max(need, int(np.ceil(t - PIECE_ROUNDING)))
+        t = _turnings(curves, TURN_SEGMENTS * s, params) / PIECE_TURN
+        over = t > s * (1 + PIECE_ROUNDING)
+        need[over] = np.maximum(need[over], np.ceil(t[over] - PIECE_ROUNDING).astype(np.int64))
     return need
 
 
@@ -109,7 +150,7 @@ def curve_pieces(curves: list, closed: np.ndarray) -> np.ndarray:
 
     ``max(1, ceil(length / (PIECE_LENGTH * median length)), turning pieces)``, at least 2
     for a closed curve; the turning pieces are what the curve's turning asks for at the
-    scales of one to :data:`TURN_SCALES` pieces (:func:`_turn_pieces`).
+    scales of one to :data:`TURN_SCALES` pieces (:func:`_turns_pieces`).
 
     Returns
     -------
@@ -117,7 +158,7 @@ def curve_pieces(curves: list, closed: np.ndarray) -> np.ndarray:
     """
     lengths = np.array([arc_length(c) for c in curves])
     med = float(np.median(lengths)) if len(lengths) else 1.0
-    turn = np.array([_turn_pieces(np.asarray(c, dtype=np.float64)) for c in curves])
+    turn = _turns_pieces([np.asarray(c, dtype=np.float64) for c in curves])
     # a curve exactly PIECE_LENGTH medians long (rounding noise aside) stays one piece
     m = np.maximum(np.ceil(lengths / (PIECE_LENGTH * max(med, DIVISION_GUARD)) - PIECE_ROUNDING),
                    turn)

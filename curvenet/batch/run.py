@@ -34,8 +34,10 @@ import dataclasses
 import hashlib
 import json
 import os
+import signal
 import sys
 import tempfile
+import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -57,6 +59,13 @@ STATUSES = ("ok", "skipped", "error", "internal")
 
 #: Tile size (pixels) of the per-file pictures of a contact sheet.
 TILE_SIZE = (360, 300)
+
+#: Seconds between two looks of a pool worker at its parent process (the fallback of
+#: :func:`_exit_with_parent` where the kernel cannot signal a parent's death).
+PARENT_POLL = 0.5
+
+#: ``prctl`` option asking the kernel for a signal when the parent dies (linux/prctl.h).
+_PR_SET_PDEATHSIG = 1
 
 
 @dataclass(frozen=True)
@@ -238,13 +247,56 @@ def _worker_name() -> str:
 
 
 # --------------------------------------------------------------------------- executors
+def _set_death_signal() -> bool:
+    """Ask the Linux kernel to SIGKILL this process when its parent dies; False elsewhere."""
+    if not sys.platform.startswith("linux"):
+        return False
+    import ctypes
+    try:
+        libc = ctypes.CDLL(None, use_errno=True)
+        return libc.prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0) == 0
+    except (OSError, AttributeError):
+        return False
+
+
+def _watch_parent(parent: int) -> None:
+    """Exit this process at once when ``parent`` is no longer its parent (it died)."""
+    while True:
+        if os.getppid() != parent:
+            os._exit(1)
+        time.sleep(PARENT_POLL)
+
+
+def _exit_with_parent(parent: int) -> None:
+    """Pool initializer: the worker ends when the batch process ``parent`` dies.
+
+    A pool worker whose parent is killed (SIGKILL, the out-of-memory killer) would
+    otherwise sleep on for ever, holding its memory. The kernel's parent-death signal
+    (``prctl(PR_SET_PDEATHSIG, SIGKILL)``, Linux) ends it at once; a daemon thread that
+    looks at ``os.getppid()`` every :data:`PARENT_POLL` seconds covers other systems and
+    a parent that died before the signal was set up.
+    """
+    _set_death_signal()
+    if os.getppid() != parent:
+        os._exit(1)
+    threading.Thread(target=_watch_parent, args=(parent,), name="curvenet-parent-watch",
+                     daemon=True).start()
+
+
+def _pool(workers: int):
+    """A process pool whose workers exit when this process dies (:func:`_exit_with_parent`)."""
+    from concurrent.futures import ProcessPoolExecutor
+    return ProcessPoolExecutor(max_workers=workers, initializer=_exit_with_parent,
+                               initargs=(os.getpid(),))
+
+
 class LocalExecutor:
     """Run tasks in this process (``jobs=1``) or a pool of ``jobs`` processes.
 
     Tasks carry paths. When a pool process dies (a crash in native code, the kernel's
     out-of-memory killer), the whole pool breaks; the unfinished tasks then run one per
     fresh process (``jobs`` at a time), so a crash costs only its own file, which is
-    reported as ``internal``.
+    reported as ``internal``. Workers exit when this process dies.
     """
 
     def __init__(self, jobs: int = 1):
@@ -259,10 +311,10 @@ class LocalExecutor:
             for i, path in enumerate(tasks):
                 yield i, surface_task(path, None, options, **render)
             return
-        from concurrent.futures import ProcessPoolExecutor, ThreadPoolExecutor, as_completed
+        from concurrent.futures import ThreadPoolExecutor, as_completed
         from concurrent.futures.process import BrokenProcessPool
         broken = []
-        with ProcessPoolExecutor(max_workers=self.jobs) as pool:
+        with _pool(self.jobs) as pool:
             futures = {pool.submit(surface_task, path, None, options, **render): i
                        for i, path in enumerate(tasks)}
             for fut in as_completed(futures):
@@ -279,9 +331,8 @@ class LocalExecutor:
 
 def _isolated(path: str, options: BatchOptions, render: dict) -> dict:
     """Run one task in a process of its own; its death is this file's failure alone."""
-    from concurrent.futures import ProcessPoolExecutor
     from concurrent.futures.process import BrokenProcessPool
-    with ProcessPoolExecutor(max_workers=1) as pool:
+    with _pool(1) as pool:
         try:
             return pool.submit(surface_task, path, None, options, **render).result()
         except BrokenProcessPool:

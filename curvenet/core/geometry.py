@@ -27,6 +27,7 @@ __all__ = [
     "arc_length",
     "arc_length_params",
     "interpolate_polyline",
+    "densify_polylines",
     "segment_closest",
     "sample_at",
     "resample_polyline",
@@ -255,6 +256,42 @@ def densify_polyline(polyline: np.ndarray, max_step: float) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------- triangles
+def densify_polylines(polylines, max_step: float):
+    """:func:`densify_polyline` of many polylines at once (the same points).
+
+    Parameters
+    ----------
+    polylines : list of (n_k, d) float64, n_k >= 1
+    max_step : float, > 0
+
+    Returns
+    -------
+    points : (m, d) float64
+        The densified polylines one after the other.
+    counts : (K,) int64
+        Points of each.
+
+    Examples
+    --------
+    >>> pts, counts = densify_polylines([np.array([[0.0, 0], [1, 0]]), np.zeros((1, 2))], 0.4)
+    >>> counts.tolist(), pts[:, 0].tolist()
+    ([4, 1], [0.0, 0.3333333333333333, 0.6666666666666666, 1.0, 0.0])
+    """
+    sizes = np.array([len(p) for p in polylines], np.int64)
+    p = np.concatenate([np.asarray(q, dtype=np.float64) for q in polylines])
+    last = np.cumsum(sizes) - 1
+    seg = np.diff(p, axis=0)                                              # (N - 1, d)
+    steps = np.maximum(np.ceil(np.linalg.norm(seg, axis=1) / max_step).astype(np.int64), 1)
+    steps[last[:-1]] = 1                   # a polyline's last point, before the next's first
+    seg_id = np.repeat(np.arange(len(seg)), steps)
+    start = np.cumsum(steps) - steps
+    t = (np.arange(steps.sum()) - start[seg_id]) / steps[seg_id]          # 0, 1/k, ...
+    out = np.concatenate([p[seg_id] + t[:, None] * seg[seg_id], p[-1:]])
+    # the step from each last point to the next polyline is that last point alone
+    counts = np.add.reduceat(np.append(steps, 1), np.concatenate([[0], last[:-1] + 1]))
+    return out, counts
+
+
 def segment_closest(p0, p1, q0, q1):
     """Closest points of segment pairs, batched (Ericson, Real-Time Collision Detection 5.1.9).
 

@@ -23,7 +23,7 @@ from collections import deque
 import numpy as np
 
 from .gf2 import edge_mask
-from ..core.geometry import cumulative_length
+from ..core.polylines import Polylines, row_dots
 from ..core.tolerances import DIVISION_GUARD
 from ..core.errors import InvalidParameterError, NetworkError
 from .loops import cycle_to_loop, newell_normal
@@ -134,9 +134,9 @@ class Candidate:
 class CandidatePool:
     """Candidate cycles of a network, enumerated length by length (Algorithm 1).
 
-    Precomputes adjacency, per-vertex search distances and per-edge geometric
-    moments once; :meth:`cycles_of_length` then enumerates and weighs all simple
-    cycles of one length, each exactly once.
+    Precomputes adjacency and per-edge geometric moments once;
+    :meth:`cycles_of_length` then enumerates and weighs all simple cycles of one
+    length, each exactly once.
 
     Parameters
     ----------
@@ -159,7 +159,8 @@ class CandidatePool:
     depth-first search through vertices ``> s`` and kept only when its first
     edge id is smaller than its last (each undirected cycle has two directions).
     Paths are pruned when ``depth + dist_s(x) > L``, with ``dist_s`` the
-    breadth-first distance to ``s`` inside the vertices ``>= s``.
+    breadth-first distance to ``s`` inside the vertices ``>= s``, searched up to
+    ``L // 2`` hops (as the numba kernel does: no vertex of such a cycle lies farther).
     """
 
     def __init__(self, network: CurveNetwork, *, tie_break: str = "pca",
@@ -187,7 +188,6 @@ class CandidatePool:
             lst.sort()
         self.nbrs = [sorted({y for y, _ in lst}) for lst in self.adj]
         self.loops = [e for e, (u, v) in enumerate(ends.tolist()) if u == v]
-        self._dist = [None] * nv
         self._by_length: dict = {}        # L -> candidates of cycles_of_length(L)
         self._candidates: list = []       # every candidate handed out, in enumeration order
         self._sorted = None               # cache of all_candidates
@@ -237,19 +237,24 @@ class CandidatePool:
             c += 1
         return comp
 
-    def _dist_from(self, s: int) -> dict:
-        d = self._dist[s]
-        if d is None:
-            d = {s: 0}
-            q = deque([s])
-            while q:
-                x = q.popleft()
-                dx = d[x] + 1
-                for y in self.nbrs[x]:
-                    if y > s and y not in d:
-                        d[y] = dx
-                        q.append(y)
-            self._dist[s] = d
+    def _dist_from(self, s: int, reach: int) -> dict:
+        """Hop distances from ``s`` inside the vertices ``>= s``, up to ``reach`` hops.
+
+        Every vertex of a cycle of ``L`` edges through its smallest vertex ``s`` lies
+        within ``L // 2`` hops of ``s``, so that reach prunes the search exactly as the
+        whole breadth-first tree would, at a cost bounded by the ball, not the graph.
+        """
+        d = {s: 0}
+        q = deque([s])
+        while q:
+            x = q.popleft()
+            dx = d[x] + 1
+            if dx > reach:
+                continue
+            for y in self.nbrs[x]:
+                if y > s and y not in d:
+                    d[y] = dx
+                    q.append(y)
         return d
 
     def is_separating(self, vertices) -> bool:
@@ -285,26 +290,27 @@ class CandidatePool:
 
     # --- geometry -------------------------------------------------------------
     def _edge_geometry(self):
-        """Per-edge AABB and arc-length moments (uniform density along each curve)."""
+        """Per-edge AABB and arc-length moments (uniform density along each curve), for
+        all curves of one point count at once."""
         ne = self.n_edges
+        self._lines = Polylines([e.curve for e in self.network.edges])
         self._emin = np.zeros((ne, 3))
         self._emax = np.zeros((ne, 3))
         self._m0 = np.zeros(ne)
         self._m1 = np.zeros((ne, 3))
         self._m2 = np.zeros((ne, 3, 3))
-        for i, e in enumerate(self.network.edges):
-            c = e.curve
-            self._emin[i] = c.min(axis=0)
-            self._emax[i] = c.max(axis=0)
-            a, b = c[:-1], c[1:]
-            seg = np.linalg.norm(b - a, axis=1)  # (m-1,)
-            self._m0[i] = seg.sum()
-            self._m1[i] = (seg[:, None] * (a + b)).sum(axis=0) / 2.0
+        for ids, c, _ in self._lines.groups:
+            self._emin[ids] = c.min(axis=1)
+            self._emax[ids] = c.max(axis=1)
+            a, b = c[:, :-1], c[:, 1:]
+            seg = np.linalg.norm(b - a, axis=2)  # (g, m-1)
+            self._m0[ids] = seg.sum(axis=1)
+            self._m1[ids] = (seg[:, :, None] * (a + b)).sum(axis=1) / 2.0
             # exact second moment of a uniform segment: l (aa' + bb' + (ab' + ba')/2) / 3
-            self._m2[i] = np.einsum("s,si,sj->ij", seg / 3.0, a, a) \
-                + np.einsum("s,si,sj->ij", seg / 3.0, b, b) \
-                + np.einsum("s,si,sj->ij", seg / 6.0, a, b) \
-                + np.einsum("s,si,sj->ij", seg / 6.0, b, a)
+            self._m2[ids] = np.einsum("gs,gsi,gsj->gij", seg / 3.0, a, a) \
+                + np.einsum("gs,gsi,gsj->gij", seg / 3.0, b, b) \
+                + np.einsum("gs,gsi,gsj->gij", seg / 6.0, a, b) \
+                + np.einsum("gs,gsi,gsj->gij", seg / 6.0, b, a)
         self.diagonal = max(self.network.diagonal, DIVISION_GUARD)
 
     def measures(self, edge_lists):
@@ -387,15 +393,11 @@ class CandidatePool:
 
     def _end_tangents(self):
         """Unit tangents ``(E, 2, 3)`` pointing into each curve from its u and v ends."""
-        t = np.zeros((self.n_edges, 2, 3))
-        for i, e in enumerate(self.network.edges):
-            c = e.curve
-            s = cumulative_length(c)
-            if s[-1] <= 0:
-                continue
-            d = _END_TANGENT_FRAC * s[-1]
-            t[i, 0] = np.array([np.interp(d, s, c[:, k]) for k in range(3)]) - c[0]
-            t[i, 1] = np.array([np.interp(s[-1] - d, s, c[:, k]) for k in range(3)]) - c[-1]
+        total = self._lines.length
+        d = _END_TANGENT_FRAC * total
+        ends = np.array([(e.curve[0], e.curve[-1]) for e in self.network.edges]).reshape(-1, 2, 3)
+        t = self._lines.interp(np.stack([d, total - d], axis=1)) - ends
+        t[total <= 0] = 0.0
         n = np.linalg.norm(t, axis=2, keepdims=True)
         return t / np.maximum(n, DIVISION_GUARD)
 
@@ -438,6 +440,16 @@ class CandidatePool:
             loop = cycle_to_loop(self.network, sorted(es))
         except NetworkError:
             return False
+        e_out = np.array([e for e, _ in loop], np.int64)
+        s_out = np.array([0 if f else 1 for _, f in loop], np.int64)
+        e_in = np.concatenate([e_out[-1:], e_out[:-1]])
+        s_in = 1 - np.concatenate([s_out[-1:], s_out[:-1]])
+        a_all = self._tangents[e_out, s_out]     # leaving each vertex along the loop
+        p_all = self._tangents[e_in, s_in]       # leaving it back along the loop
+        # a corner of the cycle (a @ p > -cos): faces have corners, handle rings do not
+        straight = np.flatnonzero(~(row_dots(a_all, p_all) > -_STRAIGHT_COS))
+        if len(straight) == 0:
+            return False
         n = newell_normal(self.network, loop)
         if not np.isfinite(n).all() or np.linalg.norm(n) < 0.5:
             return False
@@ -451,15 +463,13 @@ class CandidatePool:
         def angle(t):
             return np.arctan2(t @ y, t @ x)
 
-        for i, (e_out, fwd_out) in enumerate(loop):
-            e_in, fwd_in = loop[i - 1]
-            v = self._ends[e_out, 0 if fwd_out else 1]
-            a = self._tangents[e_out, 0 if fwd_out else 1]   # leaving v along the loop
-            p = self._tangents[e_in, 1 if fwd_in else 0]     # leaving v back along the loop
+        for i in straight.tolist():
+            a, p = a_all[i], p_all[i]
+            v = self._ends[e_out[i], s_out[i]]
             out = np.array([self._tangents[e, side] for e, side in self._incident[int(v)]
                             if e not in es]).reshape(-1, 3)
-            if len(out) == 0 or a @ p > -_STRAIGHT_COS:
-                continue  # a corner of the cycle: faces have corners, handle rings do not
+            if len(out) == 0:
+                continue
             elev = out @ n
             if elev.max() > lim and elev.min() < -lim:
                 return True
@@ -512,7 +522,8 @@ class CandidatePool:
         return edges, verts
 
     def _raw_cycles_python(self, L: int):
-        found = simple_cycles(self.adj, L, self._dist_from, self.work, self.max_work)
+        found = simple_cycles(self.adj, L, lambda s: self._dist_from(s, L // 2), self.work,
+                              self.max_work)
         self.work = found[2]
         if found[0] is None:
             self.work_bound_hit = True

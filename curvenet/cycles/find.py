@@ -291,7 +291,8 @@ def _face_patches(pool, faces, close: str, max_cycle_length=None) -> list:
     kept = _independent_faces(unique, pool.n_edges)
     added = []
     if close == "auto" and kept:
-        rest = [c for c in unique if c not in kept] + pool.all_candidates
+        taken = {id(c) for c in kept}
+        rest = [c for c in unique if id(c) not in taken] + pool.all_candidates
         added = auto_close(pool, [c.edges for c in kept], max(c.length for c in kept),
                            candidates=rest, faces=seen)
     return [Patch(c.edges, "auto") for c in kept] + [Patch(e, "closing") for e in added]

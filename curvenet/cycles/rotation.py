@@ -38,7 +38,7 @@ import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import breadth_first_order, connected_components, minimum_spanning_tree
 
-from ..core.geometry import cumulative_length, interpolate_polyline
+from ..core.polylines import Polylines, row_norms
 from ..core.tolerances import DIVISION_GUARD
 from ..model.network import CurveNetwork
 
@@ -186,11 +186,12 @@ def _polyline(network: CurveNetwork, path) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------- geometry
-def _end_tangent(poly: np.ndarray, cum: np.ndarray, reach: float) -> np.ndarray:
-    d = min(TANGENT_FRAC * cum[-1], reach)
-    p = interpolate_polyline(poly, [max(d, DIVISION_GUARD)], cum=cum)[0]
-    t = p - poly[0]
-    return t / max(np.linalg.norm(t), DIVISION_GUARD)
+def _end_tangents(lines: Polylines, start: np.ndarray, reach: float) -> np.ndarray:
+    """Unit chords ``(C, 3)`` from each polyline's first point to its point at
+    :data:`TANGENT_FRAC` of its length (at most ``reach``) along it."""
+    d = np.maximum(np.minimum(TANGENT_FRAC * lines.length, reach), DIVISION_GUARD)
+    t = lines.at(d[:, None])[:, 0] - start
+    return t / np.maximum(row_norms(t), DIVISION_GUARD)[:, None]
 
 
 def _cyclic_orders(k: int):
@@ -198,6 +199,37 @@ def _cyclic_orders(k: int):
     if k <= 3:
         return [tuple(range(k))]
     return [(0,) + p for p in permutations(range(1, k)) if p[0] < p[-1]]
+
+
+def _all_orders(around: dict, tangents: np.ndarray) -> dict:
+    """:func:`_orders` of every junction, as lists of half-edges: junction -> options, in
+    the order of ``around``.
+
+    Junctions with 3 to :data:`MAX_ENUMERATED` curves are taken in groups of equal
+    count, all their cyclic orders compared at once; the others one by one.
+    """
+    by_k: dict = {}
+    for v, hs in around.items():
+        by_k.setdefault(len(hs) if 3 <= len(hs) <= MAX_ENUMERATED else 0, []).append(v)
+    options = {}
+    for v in by_k.pop(0, []):
+        hs = around[v]
+        options[v] = [([hs[i] for i in o], n, s) for o, n, s in _orders(tangents[hs])]
+    for k, vs in by_k.items():
+        orders = np.array(_cyclic_orders(k))                             # (o, k)
+        hs = np.array([around[v] for v in vs], np.int64)                  # (J, k)
+        t = tangents[hs][:, orders]                                       # (J, o, k, 3)
+        area = np.cross(t, np.roll(t, -1, axis=2)).sum(axis=2)            # (J, o, 3)
+        mag = np.linalg.norm(area, axis=2)                                # (J, o)
+        rank = np.argsort(-mag, axis=1, kind="stable")[:, :MAX_ALTERNATIVES]
+        top = np.take_along_axis(mag, rank, axis=1)
+        keep = top >= ALTERNATIVE * top[:, :1]
+        unit = area / np.maximum(mag, DIVISION_GUARD)[..., None]
+        ring = hs[:, orders]                                              # (J, o, k)
+        for r, v in enumerate(vs):
+            options[v] = [(ring[r, j].tolist(), unit[r, j], float(mag[r, j] / k))
+                          for j, ok in zip(rank[r].tolist(), keep[r].tolist()) if ok]
+    return {v: options[v] for v in around}      # junction order: the descent's order
 
 
 def _orders(tangents: np.ndarray) -> list:
@@ -230,7 +262,7 @@ def _orders(tangents: np.ndarray) -> list:
              float(mag[j] / k)) for j in keep]
 
 
-def _transports(polys) -> np.ndarray:
+def _transports(lines: Polylines) -> np.ndarray:
     """Per polyline, the linear map that carries a normal from its first point to its last,
     up to a positive factor: ``(c, 3, 3)``.
 
@@ -240,11 +272,12 @@ def _transports(polys) -> np.ndarray:
     for all polylines at once, one segment at a time.
     """
     m = TRANSPORT_SAMPLES
-    pts = np.stack([interpolate_polyline(p, np.linspace(0, c[-1], m), cum=c)
-                    for p, c in ((p, cumulative_length(p)) for p in polys)])  # (c, m, 3)
+    s = np.arange(m)[None, :] * (lines.length / (m - 1))[:, None]     # np.linspace, per row
+    s[:, -1] = lines.length
+    pts = lines.at(s)                                                     # (c, m, 3)
     seg = np.diff(pts, axis=1)
     seg /= np.maximum(np.linalg.norm(seg, axis=2, keepdims=True), DIVISION_GUARD)
-    T = np.broadcast_to(np.eye(3), (len(polys), 3, 3)).copy()
+    T = np.broadcast_to(np.eye(3), (len(pts), 3, 3)).copy()
     for j in range(m - 1):
         t = seg[:, j]                                                     # (c, 3)
         T = T - t[:, :, None] * np.einsum("ci,cij->cj", t, T)[:, None, :]
@@ -268,18 +301,18 @@ def _junctions(network: CurveNetwork, alive: np.ndarray) -> _Junctions:
     nodes, chains = _chains(network, alive)
     reach = TANGENT_REACH * max(network.diagonal, DIVISION_GUARD)
     polys = [_polyline(network, path) for _, _, path in chains]
-    cums = [cumulative_length(p) for p in polys]
+    lines = Polylines(polys)
     # half-edge 2 k leaves node a of chain k, 2 k + 1 leaves node b (backwards)
-    tangents = np.array([[_end_tangent(p, c, reach), _end_tangent(p[::-1], c[-1] - c[::-1],
-                                                                   reach)]
-                         for p, c in zip(polys, cums)]).reshape(-1, 3)
+    tangents = np.stack([
+        _end_tangents(lines, np.array([p[0] for p in polys]), reach),
+        _end_tangents(Polylines(polys, reverse=True), np.array([p[-1] for p in polys]), reach),
+    ], axis=1).reshape(-1, 3)
     origin = np.array([[a, b] for a, b, _ in chains], np.int64).ravel()
     around: dict = {}
-    for h, v in enumerate(origin):
-        around.setdefault(int(v), []).append(h)
-    options = {v: [([hs[i] for i in o], n, s) for o, n, s in _orders(tangents[hs])]
-               for v, hs in around.items()}
-    return _Junctions(nodes, chains, origin, around, options, _transports(polys))
+    for h, v in enumerate(origin.tolist()):
+        around.setdefault(v, []).append(h)
+    options = _all_orders(around, tangents)
+    return _Junctions(nodes, chains, origin, around, options, _transports(lines))
 
 
 # --------------------------------------------------------------------------- faces
@@ -398,13 +431,20 @@ def _orient(J: _Junctions, normal: dict, strength: dict):
     flip = {}
     for j in js:
         flip[(int(ia[j]), int(ib[j]))] = flip[(int(ib[j]), int(ia[j]))] = dot[j] < 0
-    s = np.ones(n, np.int64)
+    s = np.ones(n + 1, np.int64)
     _, comp = connected_components(tree, directed=False)
-    for c in np.unique(comp):
-        root = int(np.flatnonzero(comp == c)[0])
-        seq, pred = breadth_first_order(tree, root, directed=False)
-        for x in seq[1:]:
-            s[x] = s[pred[x]] * (-1 if flip[(int(pred[x]), int(x))] else 1)
+    # one search from a root joined to the first junction of every component
+    roots = np.unique(comp, return_index=True)[1]
+    t, hub = tree.tocoo(), np.full(len(roots), n)
+    joined = coo_matrix((np.r_[t.data, np.ones(2 * len(roots))],
+                         (np.r_[t.row, hub, roots], np.r_[t.col, roots, hub])),
+                        shape=(n + 1, n + 1)).tocsr()
+    seq, pred = breadth_first_order(joined, n, directed=False)
+    first = set(roots.tolist())
+    for x, px in zip(seq[1:].tolist(), pred[seq[1:]].tolist()):
+        if x not in first:
+            s[x] = s[px] * (-1 if flip[(px, x)] else 1)
+    s = s[:n]
     conflicts = int(np.count_nonzero((s[ia] * s[ib] * np.sign(dot) < 0) & (weight > 0.1)))
     return {int(v): int(s[i]) for i, v in enumerate(nodes)}, conflicts
 
@@ -442,10 +482,7 @@ def _genus(nodes, chains, loops) -> list:
     for k, (_, _, path) in enumerate(chains):
         for i, _ in path:
             chain_of[i] = k
-    faces = np.bincount([comp[a[chain_of[lp[0][0]]]] for lp in loops], minlength=comp.max() + 1)
-    out = []
-    for c in range(comp.max() + 1):
-        chi = int(np.count_nonzero(comp == c)) - int(np.count_nonzero(comp[a] == c)) \
-            + int(faces[c])
-        out.append(1 - chi // 2 if chi % 2 == 0 else None)
-    return out
+    m = comp.max() + 1
+    faces = np.bincount([comp[a[chain_of[lp[0][0]]]] for lp in loops], minlength=m)
+    chi = np.bincount(comp, minlength=m) - np.bincount(comp[a], minlength=m) + faces
+    return [1 - int(x) // 2 if x % 2 == 0 else None for x in chi]

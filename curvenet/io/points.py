@@ -57,6 +57,7 @@ from ..core.errors import InvalidParameterError, SketchFormatError
 from ..model.sketch import Sketch
 
 __all__ = ["JUMP_RATIO", "MIN_BLOCK_POINTS", "NotCurvesError", "PointCurves", "jump_ratio",
+           "jump_ratios",
            "dimension_profile",
            "recover_curves", "read_point_blocks"]
 
@@ -65,6 +66,7 @@ __all__ = ["JUMP_RATIO", "MIN_BLOCK_POINTS", "NotCurvesError", "PointCurves", "j
 JUMP_RATIO = 8.0
 
 _PROBES = 200_000            # largest sample that neighbour statistics are taken on
+_RUN_POINTS = 50_000         # points of the strokes whose jump ratios are taken at once
 
 #: Blocks with fewer points are always read as polylines (too few to tell).
 MIN_BLOCK_POINTS = 20
@@ -133,6 +135,60 @@ def jump_ratio(points) -> float:
     if nn.size == 0 or steps.size == 0:
         return 1.0
     return float(np.median(steps) / np.median(nn))
+
+
+def jump_ratios(strokes) -> np.ndarray:
+    """:func:`jump_ratio` of many strokes at once: ``(K,) float64``, the same values.
+
+    The nearest-neighbour spacings of a run of strokes (about :data:`_RUN_POINTS` points,
+    which bounds the memory) come from one KD-tree, with the strokes set apart along a
+    fourth axis (farther than any two points of one stroke), and the medians from one
+    sort; strokes over :data:`_PROBES` points are measured one by one (their probes are
+    drawn at random).
+    """
+    sizes = np.array([len(s) for s in strokes], np.int64)
+    out = np.ones(len(strokes))
+    for k in np.flatnonzero(sizes > _PROBES):
+        out[k] = jump_ratio(strokes[k])
+    use = np.flatnonzero((sizes >= 3) & (sizes <= _PROBES))
+    cut = np.flatnonzero(np.diff(np.cumsum(sizes[use]) // _RUN_POINTS)) + 1
+    for run in np.split(use, cut):
+        if len(run):
+            out[run] = _run_ratios([strokes[k] for k in run])
+    return out
+
+
+def _run_ratios(strokes) -> np.ndarray:
+    """:func:`jump_ratio` of strokes of 3 to :data:`_PROBES` points, ``(K,) float64``."""
+    p = np.concatenate([np.asarray(s, dtype=np.float64) for s in strokes])
+    owner = np.repeat(np.arange(len(strokes)), [len(s) for s in strokes])
+    apart = 4.0 * float(np.abs(p).max()) + 1.0          # over any stroke's diameter
+    q = np.column_stack([p, owner * apart])
+    nn = cKDTree(q).query(q, k=2)[0][:, 1]
+    del q
+    steps = np.linalg.norm(np.diff(p, axis=0), axis=1)
+    inside = owner[1:] == owner[:-1]                    # not from one stroke to the next
+    step_of, steps = owner[1:][inside], steps[inside]
+    m_nn = _medians(nn[nn > 0], owner[nn > 0], len(strokes))
+    m_step = _medians(steps[steps > 0], step_of[steps > 0], len(strokes))
+    ok = np.isfinite(m_nn) & np.isfinite(m_step)
+    out = np.ones(len(strokes))
+    out[ok] = m_step[ok] / m_nn[ok]
+    return out
+
+
+def _medians(values, group, n: int) -> np.ndarray:
+    """Median of ``values`` per ``group`` (``0 .. n - 1``), as :func:`numpy.median` takes
+    it; NaN for an empty group: ``(n,) float64``."""
+    order = np.lexsort((values, group))
+    v = values[order]
+    count = np.bincount(group, minlength=n)
+    mid = np.cumsum(count) - count + count // 2
+    out = np.full(n, np.nan)
+    odd, even = count % 2 == 1, (count > 0) & (count % 2 == 0)
+    out[odd] = v[mid[odd]]
+    out[even] = (v[mid[even] - 1] + v[mid[even]]) / 2
+    return out
 
 
 # --------------------------------------------------------------------------- scale
@@ -402,9 +458,11 @@ def read_point_blocks(sketch: Sketch, points="auto") -> Sketch:
         raise InvalidParameterError(f"points: {points!r} is not 'auto', True or False")
     src = sketch.source
     strokes, labels, blocks = [], [], []
-    for i, (s, lab) in enumerate(zip(sketch.strokes, sketch.labels)):
-        ratio = jump_ratio(s) if points is True or (points == "auto" and
-                                                    len(s) >= MIN_BLOCK_POINTS) else 1.0
+    measured = [i for i, s in enumerate(sketch.strokes)
+                if points is True or (points == "auto" and len(s) >= MIN_BLOCK_POINTS)]
+    ratios = np.ones(len(sketch))
+    ratios[measured] = jump_ratios([sketch.strokes[i] for i in measured])
+    for i, (s, lab, ratio) in enumerate(zip(sketch.strokes, sketch.labels, ratios.tolist())):
         if points is True or (points == "auto" and len(s) >= MIN_BLOCK_POINTS
                               and ratio > JUMP_RATIO):
             rc = recover_curves(s, name=f"stroke {i + 1} ({len(s)} points, consecutive points "

@@ -75,7 +75,7 @@ from dataclasses import asdict, dataclass, replace
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..core.geometry import densify_polyline, segment_closest
+from ..core.geometry import densify_polylines, segment_closest
 from ..core.tolerances import (COINCIDENT_REL, DIVISION_GUARD, DUPLICATE_POINT_REL,
                                check_snap_tol)
 from ..core.errors import InvalidParameterError
@@ -99,6 +99,8 @@ CROSSING_AWAY = 0.02
 CROSSING_ANGLE = 20.0
 #: Sample spacing of the crossing test, fraction of the diagonal.
 CROSSING_STEP = 0.005
+#: Samples whose neighbours the crossing test gathers at a time (bounds its memory).
+_CROSSING_CHUNK = 20_000
 
 #: Default snapping tolerance, a fraction of the bounding-box diagonal. Chosen so
 #: that rough redraws (0.3% wobble, ends off by up to 1.5%, 1% gaps) snap
@@ -201,30 +203,39 @@ def _prepare(sketch, opts):
 def _crosses(strokes, diag) -> bool:
     """Whether two strokes cross (pass within :data:`CROSSING_REL` of the diagonal of each
     other at an angle, away from the points they share): then they are drawn, not
-    exported."""
+    exported.
+
+    Sample pairs of different strokes within ``2 CROSSING_STEP`` of each other are tested
+    where the first of the pair lies :data:`CROSSING_AWAY` or farther from every shared
+    point; pairs are gathered only around such points, at most :data:`_CROSSING_CHUNK`
+    of them at a time, so the many pairs around junctions are never formed.
+    """
     eps = COINCIDENT_REL * diag
     step = CROSSING_STEP * diag
-    dense = [densify_polyline(s, step) for s in strokes]
-    pts = np.concatenate(dense)
-    sid = np.repeat(np.arange(len(dense)), [len(d) for d in dense])
+    pts, counts = densify_polylines(strokes, step)
+    sid = np.repeat(np.arange(len(strokes)), counts)
+    last = np.cumsum(counts) - 1
     tree = cKDTree(pts)
     shared = tree.query_pairs(eps, output_type="ndarray")
     shared = shared[sid[shared[:, 0]] != sid[shared[:, 1]]]
-    pairs = tree.query_pairs(2 * step, output_type="ndarray")
-    pairs = pairs[sid[pairs[:, 0]] != sid[pairs[:, 1]]]
+    far = np.arange(len(pts))
     if len(shared):
-        near = cKDTree(pts[shared[:, 0]]).query(pts[pairs[:, 0]])[0] < CROSSING_AWAY * diag
-        pairs = pairs[~near]
-    if not len(pairs):
-        return False
-    last = np.cumsum([len(d) for d in dense]) - 1
-    i, j = (np.minimum(p, last[sid[p]] - 1) for p in (pairs[:, 0], pairs[:, 1]))
-    s, t = segment_closest(pts[i], pts[i + 1], pts[j], pts[j + 1])
-    a, b = pts[i + 1] - pts[i], pts[j + 1] - pts[j]
-    gap = np.linalg.norm(pts[i] + s[:, None] * a - pts[j] - t[:, None] * b, axis=1)
-    cos = np.abs(np.einsum("ij,ij->i", a, b)) / np.maximum(
-        np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1), DIVISION_GUARD)
-    return bool(np.any((gap < CROSSING_REL * diag) & (cos < np.cos(np.radians(CROSSING_ANGLE)))))
+        far = np.flatnonzero(cKDTree(pts[shared[:, 0]]).query(pts)[0] >= CROSSING_AWAY * diag)
+    cos_max = np.cos(np.radians(CROSSING_ANGLE))
+    for lo in range(0, len(far), _CROSSING_CHUNK):
+        ids = far[lo:lo + _CROSSING_CHUNK]
+        near = cKDTree(pts[ids]).sparse_distance_matrix(tree, 2 * step, output_type="ndarray")
+        first, second = ids[near["i"]], near["j"].astype(np.int64)
+        keep = (second > first) & (sid[first] != sid[second])
+        i, j = (np.minimum(q, last[sid[q]] - 1) for q in (first[keep], second[keep]))
+        s, t = segment_closest(pts[i], pts[i + 1], pts[j], pts[j + 1])
+        a, b = pts[i + 1] - pts[i], pts[j + 1] - pts[j]
+        gap = np.linalg.norm(pts[i] + s[:, None] * a - pts[j] - t[:, None] * b, axis=1)
+        cos = np.abs(np.einsum("ij,ij->i", a, b)) / np.maximum(
+            np.linalg.norm(a, axis=1) * np.linalg.norm(b, axis=1), DIVISION_GUARD)
+        if np.any((gap < CROSSING_REL * diag) & (cos < cos_max)):
+            return True
+    return False
 
 
 def _is_exact(strokes, diag):

@@ -315,3 +315,60 @@ def test_eval_pairs_scores_a_folder_against_references(tmp_path, capsys):
     data = json.loads(capsys.readouterr().out)
     assert [r["status"] for r in data["rows"]] == ["ok", "error"]
     assert "nothere.ply" in data["rows"][1]["error"]
+
+
+# --------------------------------------------------------------------------- issue 32
+_PARENT = r"""
+import os, sys, time
+import curvenet.batch.run as br
+
+def sleepy(path, data, options, **render):
+    with open(path + ".tmp", "w") as f:
+        f.write(str(os.getpid()))
+    os.replace(path + ".tmp", path)
+    time.sleep(120)
+    return {}
+
+br.surface_task = sleepy
+if sys.argv[2] == "poll":
+    br._set_death_signal = lambda: False     # the fallback alone: getppid() polling
+folder = sys.argv[1]
+for _ in br.LocalExecutor(2).run([f"{folder}/a.pid", f"{folder}/b.pid"], None, {}):
+    pass
+"""
+
+
+def _gone(pid: int) -> bool:
+    """No such process, or a zombie (dead, waiting to be reaped by its new parent)."""
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().rsplit(")", 1)[1].split()[0] in ("Z", "X")
+    except FileNotFoundError:
+        return True
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+@pytest.mark.parametrize("watch", ["signal", "poll"])
+def test_pool_workers_exit_within_5_s_of_their_parent_being_killed(tmp_path, watch):
+    parent = subprocess.Popen([sys.executable, "-c", _PARENT, str(tmp_path), watch])
+    pids = [tmp_path / "a.pid", tmp_path / "b.pid"]
+    try:
+        deadline = time.monotonic() + 60
+        while not all(p.exists() for p in pids):
+            assert parent.poll() is None and time.monotonic() < deadline, "workers never started"
+            time.sleep(0.05)
+        workers = [int(p.read_text()) for p in pids]
+        assert not any(_gone(w) for w in workers)
+        parent.send_signal(signal.SIGKILL)
+        parent.wait()
+        killed = time.monotonic()
+        while not all(_gone(w) for w in workers) and time.monotonic() - killed < 5:
+            time.sleep(0.05)
+        alive = [w for w in workers if not _gone(w)]
+        assert not alive, f"workers {alive} outlived their killed parent by 5 s"
+    finally:
+        if parent.poll() is None:
+            parent.kill()
+        for p in pids:
+            if p.exists() and not _gone(int(p.read_text())):
+                os.kill(int(p.read_text()), signal.SIGKILL)

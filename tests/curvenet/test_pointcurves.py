@@ -48,6 +48,29 @@ def test_jump_ratio_tells_polylines_from_shuffled_points():
     assert jump_ratio(np.random.default_rng(0).permutation(line)) > 5 * JUMP_RATIO
 
 
+def test_jump_ratios_of_many_strokes_are_each_strokes_own(monkeypatch):
+    """The batched ratios equal the one-by-one ones, bit for bit, across runs of strokes
+    (a run of 2,000 points here), with repeated points, coincident strokes, shuffled
+    blocks and strokes of one or two points."""
+    import curvenet.io.points as pc
+    monkeypatch.setattr(pc, "_RUN_POINTS", 2_000)
+    rng = np.random.default_rng(3)
+    strokes = []
+    for k in range(400):
+        s = np.cumsum(rng.normal(size=(int(rng.integers(1, 60)), 3)), axis=0) * rng.uniform(
+            1e-3, 10) + rng.uniform(-100, 100, 3)
+        if k % 7 == 0 and len(s) > 3:
+            s[2] = s[1]
+        if k % 11 == 0:
+            s = rng.permutation(s)
+        if k % 13 == 0:
+            s[:] = s[0]
+        strokes.append(s)
+    want = [jump_ratio(s) for s in strokes]
+    assert pc.jump_ratios(strokes).tolist() == want
+    assert max(want) > 3.0 and min(want) == 1.0         # shuffled blocks; tiny strokes
+
+
 def test_shuffled_circle_comes_back_closed_and_ordered():
     t = np.linspace(0, 2 * np.pi, 600) + np.random.default_rng(1).uniform(0, 0.01, 600)
     pts = np.column_stack([np.cos(t), np.sin(t), 0 * t])

@@ -185,3 +185,28 @@ def test_bad_loops_rejected():
         build_control_mesh([np.zeros((2, 3)) + [[0, 0, 0], [1, 0, 0]]], [[(3, True)]], 4)
     with pytest.raises(ValueError, match="curves\\[0\\]"):
         build_control_mesh([np.zeros((1, 3))], [[(0, True)]], 4)
+
+
+def test_vectorised_turning_is_the_per_curve_loop_bit_for_bit():
+    """Oracle: the one-curve :func:`_turning` and a loop over scales (issue 32)."""
+    from curvenet.surfacing.controlmesh import (PIECE_ROUNDING, PIECE_TURN, TURN_SCALES,
+                                                TURN_SEGMENTS, _turning, _turnings,
+                                                _turns_pieces)
+    rng = np.random.default_rng(3)
+    curves = [e.curve for e in shapes.torus().network.edges]
+    curves += [np.cumsum(rng.normal(size=(int(rng.integers(2, 80)), 3)), 0) for _ in range(200)]
+    curves += [np.zeros((4, 3)), np.array([[0.0, 0, 0], [0, 0, 0], [1, 0, 0]])]  # degenerate
+    for n in (8, 16, 24, 32):
+        loop = np.array([_turning(c, n) for c in curves])
+        assert np.array_equal(_turnings(curves, n), loop, equal_nan=True)
+
+    def pieces(c):
+        need = 1
+        for s in range(1, TURN_SCALES + 1):
+            t = _turning(c, TURN_SEGMENTS * s) / PIECE_TURN
+            if t > s * (1 + PIECE_ROUNDING):
+                need = max(need, int(np.ceil(t - PIECE_ROUNDING)))
+        return need
+    got = _turns_pieces(curves)
+    assert np.array_equal(got, [pieces(c) for c in curves])
+    assert got.max() > 1                        # the random walks do ask for pieces

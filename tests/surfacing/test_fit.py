@@ -30,6 +30,23 @@ def test_lsq_interpolates_curve_samples(name):
     assert np.abs(L[cons] @ P - q).max() < 1e-10 * cm.diagonal
 
 
+@pytest.mark.parametrize("name", ["sphere", "torus", "grid_box"])
+def test_quasi_definite_kkt_solve_is_the_pivoted_one(name, monkeypatch):
+    """Above PIVOTED_MAX unknowns the KKT system is factorised without pivoting and
+    refined: the same control points to round-off; and when refinement cannot reach
+    round-off (no steps allowed, a coarse regularisation), the pivoted solve is used."""
+    import curvenet.surfacing.fit as fit
+    cm, se, cr, L, cons, q = _setup(name)
+    F = variation_matrix(fairness_matrix(cm.quads, len(cm.vertices), se, cr))
+    pivoted = fit_lsq(L, F, cm.vertices, cons, q)
+    monkeypatch.setattr(fit, "PIVOTED_MAX", 10)
+    quasi = fit_lsq(L, F, cm.vertices, cons, q)
+    assert 0 < np.abs(quasi - pivoted).max() < 1e-11 * cm.diagonal
+    monkeypatch.setattr(fit, "_REFINE_STEPS", 0)
+    monkeypatch.setattr(fit, "QUASI_EPS", 1e-3)
+    assert np.array_equal(fit_lsq(L, F, cm.vertices, cons, q), pivoted)
+
+
 def test_lsq_penalty_trades_interpolation_for_fairness():
     cm, se, cr, L, cons, q = _setup("sphere")
     F = fairness_matrix(cm.quads, len(cm.vertices), se, cr)

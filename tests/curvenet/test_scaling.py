@@ -1,0 +1,71 @@
+"""Every stage scales about linearly with the network size (issue 32).
+
+Small-size counterpart of ``benchmarks/bench_scale.py``: the CPU seconds of reading,
+snapping, patch finding and (grid boxes only) the classical surface on grid boxes and
+dense curved networks of about 100 to 450 curves, with the exponent ``k`` of
+``cpu ~ curves^k`` fitted on log-log axes. A stage with a pair loop over patches or
+curves shows ``k`` near 2 already at these sizes (the hole search of issue 31 measures
+1.5 here); linear stages with a fixed overhead measure under 1. The dense networks'
+classical surface is left out for time: its analytic-face fit costs about 0.1 s a
+patch (benchmarks/README.md).
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+import pytest
+
+from curvenet.cycles.find import find_patches
+from curvenet.datasets.dense import dense_blob
+from curvenet.datasets.shapes import grid_box
+from curvenet.io.sketch import write_sketch
+from curvenet.io.source import load_source
+from curvenet.pipeline import surface
+from curvenet.snap.graph import snap
+
+#: Largest exponent a stage may show: linear work plus noise, below quadratic.
+MAX_EXPONENT = 1.3
+SIZES = (3, 4, 6)                  # 108, 192, 432 curves (12 n^2)
+
+
+def _cpu(fn, repeats=1):
+    """Least CPU seconds of ``repeats`` calls, and the last result."""
+    best = np.inf
+    for _ in range(repeats):
+        t = time.process_time()
+        out = fn()
+        best = min(best, time.process_time() - t)
+    return best, out
+
+
+def _stages(sketch, path, with_surface) -> dict:
+    write_sketch(path, sketch)
+    out = {}
+    out["read"], sk = _cpu(lambda: load_source(path)[0], 3)
+    out["snap"], net = _cpu(lambda: snap(sk, snap_tol="auto"), 3)
+    out["patches"], _ = _cpu(lambda: find_patches(net, close="auto"), 2)
+    if with_surface:
+        out["surface"], _ = _cpu(lambda: surface(net, method="classical"))
+    return out
+
+
+def _exponents(make, tmp_path, with_surface) -> dict:
+    _stages(make(2), tmp_path / "warm.obj", with_surface)   # imports, caches
+    rows = [(len(make(n).strokes), _stages(make(n), tmp_path / f"n{n}.obj", with_surface))
+            for n in SIZES]
+    curves = np.log([c for c, _ in rows])
+    return {s: float(np.polyfit(curves, np.log([max(r[s], 1e-4) for _, r in rows]), 1)[0])
+            for s in rows[0][1]}
+
+
+@pytest.mark.parametrize("family", ["grid", "dense"])
+def test_no_stage_grows_faster_than_curves_to_the_1_3(tmp_path, family):
+    make = (lambda n: grid_box(n).sketch()) if family == "grid" else dense_blob
+    k = _exponents(make, tmp_path, with_surface=family == "grid")
+    print(family, {s: round(v, 2) for s, v in k.items()})
+    assert set(k) == {"read", "snap", "patches"} | ({"surface"} if family == "grid" else set())
+    worst = {s: round(v, 2) for s, v in k.items() if v > MAX_EXPONENT}
+    assert not worst, f"{family}: stages growing faster than curves^{MAX_EXPONENT}: {worst} ({k})"
+
