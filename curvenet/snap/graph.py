@@ -16,14 +16,23 @@ Pipeline of :func:`snap` (``mode="rough"``)
    all sample pairs of different strokes within ``tol`` with one KD-tree
    (``scipy.spatial.cKDTree.query_pairs``). Pairs are grouped per stroke pair
    into *contacts* (runs along the first stroke).
-3. Overdraw: a contact longer than ``overdraw_length * tol`` on both strokes,
+3. Loops drawn past their start (issue 33): a stroke whose end runs back along its
+   own beginning (its last point within ``tol`` of its first 15%, its first
+   point within ``tol`` of its last 15%, the two stretches side by side within
+   ``tol`` all along and running the same way within ``overdraw_angle``, the lap
+   between enclosing an area, see :func:`curvenet.snap.overdraw.close_loops`)
+   becomes one closed loop, the two stretches averaged and the lap's ends bent onto
+   the average with the C1 bumps of step 6. Checked again after each overdraw
+   round (a ring drawn in two pieces, the second run past the first's start, is
+   one stroke by then). A stroke that spirals (its ends farther than ``tol`` from
+   the other end's stretch) or folds back over itself stays as drawn.
+   Overdraw: a contact longer than ``overdraw_length * tol`` on both strokes,
    with tangents within ``overdraw_angle``, is one curve drawn twice. The
    stroke more covered by it (the guest) loses the overlapping stretch; the
    host moves halfway onto the guest there (an average, tapered at both ends),
    so no sliver cycle remains. Repeated until no overdraw is left. A contact
    that touches both ends of a nearly closed stroke (a short stroke drawn over
-   its opening) is split where it jumps between them; a host that a guest
-   piece extends past its own start is closed there.
+   its opening) is split where it jumps between them.
 4. Every other contact is a junction candidate at its closest sample pair:
    the midpoint for a crossing or two ends (gap), the point on the other stroke
    for an end touching a stroke interior (T-junction). A stroke whose two ends
@@ -65,7 +74,17 @@ unit-box inputs give the same network up to scale. Deterministic: no random
 numbers; ties are broken by stroke and sample order.
 
 Not handled (documented gaps): a stroke crossing itself in its interior stays
-one piece there; an end touching its own stroke's interior is not snapped.
+one piece there; an end touching its own stroke's interior is not snapped, unless
+it is a loop drawn past its start (step 3); a stroke drawn round two or more times
+(an overlap over 15% of its length) stays as drawn.
+
+Departure from Abbasinejad et al. (Sec. 6.1): the paper snaps pairs of curves
+("two curves intersect when they pass within a user-defined threshold") and
+fixed by hand in Maya what that missed; ILoveSketch strokes rarely overlap
+themselves. VR designers draw a ring in one stroke and carry on past its start
+(issue 33): a pair rule never sees a stroke against itself, and the run past the
+start stays a dangling curve or doubles the patches beside it. Step 3 extends the
+overdraw merge to a stroke over its own beginning.
 """
 
 from __future__ import annotations
@@ -95,9 +114,9 @@ __all__ = ["SnapOptions", "DEFAULT_SNAP_TOL", "snap", "prune_dangling", "danglin
 DEFAULT_SNAP_TOL = 0.025
 
 #: Counters present in every ``network.report`` (see :func:`snap`).
-_COUNTERS = ("crossings", "t_junctions", "gap_merges", "closed_strokes", "trimmed_overshoots",
-             "overdraw_consolidations", "corners", "dissolved_joins", "slivers_merged",
-             "strokes_dropped_short", "strokes_trimmed_away")
+_COUNTERS = ("crossings", "t_junctions", "gap_merges", "closed_strokes", "overdrawn_loops",
+             "trimmed_overshoots", "overdraw_consolidations", "corners", "dissolved_joins",
+             "slivers_merged", "strokes_dropped_short", "strokes_trimmed_away")
 
 
 @dataclass(frozen=True)
@@ -254,7 +273,9 @@ def snap(sketch: Sketch, *, snap_tol: float | str | None = "auto", corner_angle:
         and list their source stroke ids (indices into ``sketch.strokes``).
         ``report`` (dict): ``mode``, ``tol`` (absolute), ``diagonal``,
         ``junctions`` (vertices of degree >= 3), ``t_junctions``,
-        ``crossings``, ``gap_merges``, ``closed_strokes``, ``trimmed_overshoots``,
+        ``crossings``, ``gap_merges``, ``closed_strokes``, ``overdrawn_loops``
+        (strokes whose end ran back along their own beginning, merged into one
+        loop), ``trimmed_overshoots``,
         ``overdraw_consolidations``, ``corners``, ``dissolved_joins``,
         ``slivers_merged``, ``dangling_ends`` (count) and ``dangling_vertices``
         (ids), ``strokes_used``, ``strokes_dropped_short`` (fewer than two
@@ -400,7 +421,8 @@ def summary_line(report: dict) -> str:
         tol = f"tolerance {r['snap_tol']:.2%} of the diagonal ({r['snap_tol_reason']})"
     merges = (f"{r.get('gap_merges', 0)} gaps closed, {r.get('t_junctions', 0)} T-junctions, "
               f"{r.get('crossings', 0)} crossings, {r.get('overdraw_consolidations', 0)} "
-              f"overdraws merged, {r.get('trimmed_overshoots', 0)} overshoots trimmed")
+              f"overdraws merged, {r.get('overdrawn_loops', 0)} loops drawn past their start "
+              f"closed, {r.get('trimmed_overshoots', 0)} overshoots trimmed")
     return (f"snap: {tol}; {r['vertices']} vertices, {r['edges']} curves, "
             f"{r['junctions']} junctions; {merges}; {r['dangling_ends']} dangling ends")
 
