@@ -41,7 +41,10 @@ Pipeline of :func:`snap` (``mode="rough"``)
    junctions within ``1.5 tol`` along one stroke, closest first; a gap (two
    stroke ends) that has joined a junction does not pull in a second one, nor
    do two junctions that strokes pass through merge along a short stroke that
-   runs from one to the other.
+   runs from one to the other; nor does a closed stroke's seam (its two ends
+   meeting) that has joined a junction the stroke passes through pull in a
+   second one along the stroke (a ring stopping short between two crossings
+   would chain them).
 5. Corners: where a stroke turns by more than ``corner_angle`` between the
    chords ``tol * corner_window`` before and after a point (local maximum),
    and no junction is within ``tol``, it gets a degree-2 vertex.

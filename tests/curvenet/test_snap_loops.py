@@ -1,5 +1,5 @@
-"""Snapping loops drawn past their own start (issue 33): one closed loop with the overlap
-averaged; spirals and hooks stay as drawn."""
+"""Snapping loops drawn past their own start or short of it (issue 33): one closed loop
+with the overlap averaged; spirals and hooks stay as drawn."""
 
 from __future__ import annotations
 
@@ -77,6 +77,22 @@ def test_overlap_crossed_by_a_line_is_one_crossing():
     net = _snap(_past(0.10, 0.4 * TOL), _line(-1.5 * u + [0, 0, 0.01], 1.5 * u + [0, 0, 0.01]))
     assert _degrees(net) == [1, 1, 4, 4]
     assert net.number_of_edges == 5 and net.report["crossings"] == 2
+
+
+def test_ring_short_of_its_start_between_two_crossings_closes():
+    """A ring that stops 0.75 TOL short of its start, its start 0.95 TOL before one
+    crossing line and its end 1.4 TOL after another (3.1 TOL apart): it closes, and the
+    two crossings stay two degree-4 vertices (before: the seam merged with both along
+    the ring, chaining them into one degree-6 vertex)."""
+    ring = _ring(np.linspace(0.0, 2 * np.pi - 0.75 * TOL, 600), 1.0)
+    lines = [_line([0.5 * np.cos(a), 0.5 * np.sin(a), 0.01], [1.5 * np.cos(a), 1.5 * np.sin(a),
+                                                              0.01])
+             for a in (0.95 * TOL, -(0.75 + 1.4) * TOL)]
+    net = _snap(ring, *lines)
+    assert _degrees(net) == [1, 1, 1, 1, 4, 4] and net.number_of_edges == 6
+    ring_edges = [e for e in net.edges if np.all(np.abs(np.linalg.norm(e.curve[:, :2], axis=1)
+                                                        - 1) < 0.5 * TOL)]
+    assert len(ring_edges) == 2
 
 
 @pytest.mark.parametrize("turns,pitch", [(2, 0.6), (3, 0.4)])
