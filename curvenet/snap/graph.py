@@ -369,7 +369,13 @@ def _snap_auto(strokes, src, labels, diag, opts):
     worse and better in one respect: no fewer independent cycles (the cycle
     rank, an upper bound on the patches) and no more dangling ends. A larger
     tolerance that merges small features loses cycles and is refused; a smaller
-    one that leaves gaps open adds dangling ends and is refused.
+    one that leaves gaps open adds dangling ends and is refused. At equal cycles it
+    is taken when it has fewer dangling ends because it merges more loops drawn
+    past their start (``report["overdrawn_loops"]``): a ring whose run past its
+    start lies beyond the default closes through a stroke crossing both stretches,
+    with the same cycles, and leaves the run as a dangling curve (issue 33). Fewer
+    dangling ends alone at equal cycles is not enough: on the public sketches it
+    cost patches (cassie 06-1-1, 22 -> 21).
 
     Returns (network, options with the tolerance used, reason).
     """
@@ -388,10 +394,10 @@ def _snap_auto(strokes, src, labels, diag, opts):
 
     def score(net):
         deg = np.bincount(net.endpoints.ravel(), minlength=net.number_of_vertices)
-        return net.cycle_rank(), int((deg == 1).sum())
+        return net.cycle_rank(), int((deg == 1).sum()), net.report["overdrawn_loops"]
 
-    (r_c, d_c), (r_0, d_0) = score(net_c), score(net_0)
-    if r_c > r_0 and d_c <= d_0:
+    (r_c, d_c, o_c), (r_0, d_0, o_0) = score(net_c), score(net_0)
+    if d_c <= d_0 and (r_c > r_0 or (r_c == r_0 and d_c < d_0 and o_c > o_0)):
         return net_c, cand, (f"auto: {why}; against the default {DEFAULT_SNAP_TOL:.1%}: "
                              f"cycles {r_0} -> {r_c}, dangling ends {d_0} -> {d_c}")
     return net_0, base, (f"auto: default; {tol:.2%} was measured ({why}) but gives cycles "
