@@ -17,10 +17,11 @@ meridian loop of a sphere, a rim of a cylinder, a ring of a torus) in one go:
   grows from 0 to ``x0`` over the last ``U(3%, 10%)`` of the lap (the stroke
   passes its start ``|x0|`` away, ``U(0, gap)`` times the diagonal, in a random
   direction across the ring there) and changes by a random ``d`` (also across the
-  ring at its start) over the overlap, the
-  offset staying within ``gap``. Both changes are smoothsteps no steeper than
-  :data:`_DRIFT` (15 degrees; the lap's stretch is lengthened where needed, ``d``
-  bounded), meeting with zero slope where the stroke passes its start.
+  ring at its start) over the overlap, the offset staying within ``gap``. Both
+  changes are smoothsteps, meeting with zero slope where the stroke passes its
+  start: the first no steeper than :data:`_DRIFT` (15 degrees; its stretch is
+  lengthened where needed), ``|d|`` at most :data:`_DRIFT` times the overlap (no
+  steeper than 22 degrees).
 * **Short of the start** (otherwise): the stroke stops ``U(0, gap)`` times the
   diagonal short of its start along the ring, drifted sideways (as above) by up to
   half that.
@@ -56,8 +57,9 @@ __all__ = ["SMOOTH_TURN", "smooth_chains", "loop_sketch"]
 SMOOTH_TURN = 30.0
 #: Shortest piece of a split stroke, fraction of the diagonal.
 _MIN_PIECE = 0.05
-#: Steepest sideways drift of the hand, as the largest slope of the lateral offset along
-#: the ring (1.5 times the mean slope of a smoothstep): about 15 degrees.
+#: Steepest sideways drift of the hand coming round to its start, as the largest slope of
+#: the lateral offset along the ring (1.5 times the mean slope of a smoothstep): about 15
+#: degrees; the change over the overlap is at most this times its length.
 _DRIFT = 0.27
 
 

@@ -14,9 +14,8 @@ How the tolerance is chosen
    lie close to it; free ends lie far from everything. A stroke whose two ends
    each lie within a quarter of its length of the other end's stretch (its first
    or last :data:`~curvenet.snap.strokes.LOOP_OVERLAP`: a closed stroke, or a loop
-   drawn past its start) counts those distances too (the end of a closed stroke
-   used to count only the distance between its two ends, which a loop drawn past
-   its start does not have). Sorted, the distances show the two
+   drawn past its start) counts those distances too: its ends join each other or
+   its own beginning. Sorted, the distances show the two
    populations as a jump: the largest ratio between consecutive distances
    below :data:`AUTO_MAX` separates them, and the tolerance is placed above the
    joins (``1.2 x`` the largest) and below the free ends (``/ 1.2``).
