@@ -53,6 +53,10 @@ _LAZY = {
 #: earlier names of public functions: alias -> (module, name)
 _ALIASES = {"load_network_file": ("io", "read_patches"), "save_network": ("io", "write_network"),
             "save_patchset": ("io", "write_patches")}
+#: the stages, imported on first use (``curvenet.snap`` is the subpackage; its function is
+#: ``curvenet.snap.snap``)
+_SUBPACKAGES = ("core", "model", "io", "snap", "cycles", "route", "evaluate", "cad", "view",
+                "review", "batch", "datasets", "surfacing", "neural", "pipeline", "cli")
 #: modules that moved into a subpackage, reachable under their old name
 _MOVED_MODULES = {"shapes": "datasets.shapes", "redraw": "datasets.redraw"}
 
@@ -71,6 +75,8 @@ def __getattr__(name):
         value = getattr(_import_module(f".{module}", __name__), new)
     elif name in _MOVED_MODULES:
         value = _import_module(f".{_MOVED_MODULES[name]}", __name__)
+    elif name in _SUBPACKAGES:
+        value = _import_module(f".{name}", __name__)
     else:
         raise AttributeError(f"module 'curvenet' has no attribute {name!r}")
     globals()[name] = value
@@ -79,6 +85,4 @@ def __getattr__(name):
 
 def __dir__():
     """What ``dir(curvenet)`` and tab completion show: the public names and the subpackages."""
-    return sorted(__all__ + ["__version__", "core", "model", "io", "snap", "cycles", "route",
-                             "evaluate", "cad", "view", "batch", "datasets", "surfacing",
-                             "neural", "pipeline", "cli"])
+    return sorted(__all__ + ["__version__", *_SUBPACKAGES])

@@ -275,6 +275,7 @@ def _surface_one(inp: str, out: str, args) -> dict:
                 "reading": res.diagnostics.get("reading", ""),
                 "snap": res.diagnostics.get("snap", {}).get("summary", ""),
                 "regions": res.decision.explain_regions(),
+                "check": res.decision.explain_check(),
                 "fidelity": res.diagnostics.get("fidelity"),
                 "cad": res.diagnostics.get("cad")}
     except CurvenetError as err:
@@ -285,13 +286,25 @@ def _surface_one(inp: str, out: str, args) -> dict:
 def _cad_lines(cad: dict) -> list:
     """``--explain`` lines of a CAD export: pieces, file check, the worst seams."""
     pr, fr = cad["pieces"], cad["file"]
-    lines = [f"cad: {pr['n_pieces']} B-spline faces ({pr['n_exact']} exact, level "
-             f"{pr['level']}, graded {max(pr['grades_used'], default=0)}), max deviation "
-             f"{pr['max_deviation']:.2e} of the diagonal"]
+    kinds: dict = {}
+    for f in cad["faces"]:
+        kinds[f["kind"]] = kinds.get(f["kind"], 0) + 1
+    analytic = [f["residual"] for f in cad["faces"] if f["residual"] is not None]
+    lines = [f"cad: {len(cad['faces'])} faces ("
+             + ", ".join(f"{n} {k}" for k, n in sorted(kinds.items())) + ")"
+             + (f", largest analytic residual {max(analytic):.1e} of the diagonal"
+                if analytic else "")]
+    if kinds.get("bspline"):
+        lines.append(f"cad: B-spline faces: {pr['n_exact']} of {pr['n_pieces']} pieces exact "
+                     f"(level {pr['level']}, graded {max(pr['grades_used'], default=0)}), max "
+                     f"deviation {pr['max_deviation']:.2e} of the diagonal")
     if "valid" in fr:
         lines.append(f"cad: {fr['shells']} shells, {fr['solids']} solids, {fr['free_edges']} "
                      f"free edges, valid {fr['valid']}, sewing tolerance "
-                     f"{fr['sew_tolerance']:.2e}")
+                     f"{cad['sew_tolerance']:.2e}")
+    else:
+        lines.append(f"cad: {fr['breps']} joined Breps, {fr['solids']} closed, valid "
+                     f"{fr['valid']}")
     seams = cad["seams"]
     smooth = [s for s in seams if not s["crease"]]
     lines.append(f"cad: {len(seams)} seams ({len(seams) - len(smooth)} creases), largest G0 gap "
@@ -347,6 +360,8 @@ def _cmd_surface(args) -> int:
         print(f"route: {row['why']}")
         for line in row.get("regions", []):
             print(f"  region {line}")
+        if row.get("check"):
+            print(row["check"])
         if row.get("fidelity"):
             from .core.fidelity import format_fidelity
             print(format_fidelity(row["fidelity"]))

@@ -21,15 +21,15 @@ from .cad.export import CAD_FORMATS
 from .core.errors import CurvenetError, InvalidParameterError
 from .core.fidelity import sketch_fidelity
 from .core.result import MeshResult
-from .io.common import require_file
+from .io.source import check_patches_match, load_source
 from .io.meshes import MESH_FORMATS, write_mesh, write_routed
-from .io.network import read_patches
 from .model.network import CurveNetwork
 from .model.patchset import PatchSet
 from .model.sketch import Sketch
 from .route import (AUTO_MIN_COVERAGE, Region, Route, RouteDecision, SurfaceInput,
                     SurfaceSettings, Surfacer, coverage, get_surfacer, region_route,
                     surfacer_names)
+from .route.check import judge_patches
 from .route.regions import plan_regions
 from .route.wires import stroke_wires
 
@@ -124,14 +124,20 @@ class SurfaceResult:
 
 def export_cad(path, result: SurfaceResult, *, schema: str = "AP214",
                level: int | None = None) -> dict:
-    """Write the classical surface of ``result`` as B-spline faces (STEP or 3DM).
+    """Write the classical surface of ``result`` as a B-rep (STEP or 3DM).
+
+    Patches the surfacer found to lie on a plane, cylinder, cone, sphere or torus
+    (``diagnostics["classical"]["analytic"]``) become that surface trimmed by their
+    curves, the others the B-spline pieces of the fitted control mesh
+    (:func:`surfacing.bspline.extract_bsplines`); see :func:`curvenet.cad.write_cad`.
 
     Returns
     -------
     dict
-        ``pieces`` (B-spline report of :func:`surfacing.bspline.extract_bsplines`),
-        ``seams`` (G0 gap, G1 angle and deviation per seam), ``file`` (what the
-        writer reports: faces, shells, solids, free edges, validity).
+        ``pieces`` (B-spline report), ``seams`` (G0 gap, G1 angle and deviation per
+        seam between pieces), ``faces`` (per face its patch, kind and residual),
+        ``file`` (what the writer reports: faces, shells, solids, free edges,
+        validity) and the B-rep figures of :func:`curvenet.cad.brep.brep_shape`.
     """
     from . import cad
     suffix = Path(path).suffix.lower()
@@ -147,53 +153,33 @@ def export_cad(path, result: SurfaceResult, *, schema: str = "AP214",
             f"output {path}: {int(foreign.sum())} faces came from the "
             f"neural fill (a mesh, no B-spline form) and cannot be written as CAD faces; "
             f"save a mesh format or surface with --method classical")
-    holed = sum(bool(p.holes) for p in result.patchset.patches) \
-        if result.patchset is not None else 0
-    if holed and result.diagnostics.get("classical", {}).get("flat_meshed", 0):
-        raise InvalidParameterError(
-            f"output {path}: {holed} faces with holes among flat faces meshed in their "
-            f"plane; their control mesh covers the outer loop only (no trimmed planes in "
-            f"CAD output yet); save a mesh format")
+    from curvenet.surfacing.analytic import AnalyticSurface
     from curvenet.surfacing.bspline import DEFAULT_LEVEL, extract_bsplines
+    from .cycles.loops import orient_boundaries
+    rep = result.diagnostics.get("classical", {})
+    net, ps = result.network, result.patchset
+    surfaces = [None if a is None else AnalyticSurface.from_dict(a)
+                for a in rep.get("analytic", [None] * len(ps.patches))]
+    holed_flat = [k for k, p in enumerate(ps.patches) if p.holes and surfaces[k] is None
+                  and rep.get("flat_meshed", 0)]
+    if holed_flat:
+        raise InvalidParameterError(
+            f"output {path}: {len(holed_flat)} faces with holes among flat faces meshed in "
+            f"their plane, and analytic faces are off (classical_options analytic_tol=None): "
+            f"their control mesh covers the outer loop only; save a mesh format")
+    loop_patch = rep.get("loop_patch", list(range(len(ps.patches))))
     bset = extract_bsplines(result.control_net, DEFAULT_LEVEL if level is None else level)
-    file_report = cad.write_cad(path, bset, schema=schema, wires=result.wires)
-    return {"pieces": bset.report, "seams": bset.seams, "file": file_report}
-
-
-def _is_network_json(path: Path) -> bool:
-    if path.suffix.lower() != ".json":
-        return False
-    with open(path, "rb") as fh:
-        head = fh.read(4096)
-    return b'"curvenet.network"' in head or b'"curvenet.patches"' in head
-
-
-def load_source(source, *, points="auto"):
-    """Turn what the user gave into ``(sketch, patchset)``; one of them may be None.
-
-    Parameters
-    ----------
-    source : Sketch, CurveNetwork, PatchSet, str or os.PathLike
-        A sketch, or a file: any sketch format, ``NETWORK.json`` or ``PATCHES.json``.
-    points : {"auto", True, False}
-        Reading of unordered point samples in a sketch file (see
-        :func:`curvenet.io.read_sketch`); ``True`` also recovers the curves of
-        every stroke of a :class:`Sketch` given directly.
-    """
-    if isinstance(source, Sketch):
-        if points is True:
-            from .io.points import read_point_blocks
-            return read_point_blocks(source, True), None
-        return source, None
-    if isinstance(source, PatchSet):
-        return None, source
-    if isinstance(source, CurveNetwork):
-        return None, PatchSet(source)
-    path = require_file(source)
-    if _is_network_json(path):
-        return None, read_patches(path)
-    from .io.sketch import read_sketch
-    return read_sketch(path, points=points), None
+    trimmed = [s is not None and s.kind in cad.CAD_KINDS for s in surfaces]
+    free = [pc for pc in bset.pieces if not trimmed[loop_patch[pc.patch]]]
+    diag = bset.report.get("diagonal", 1.0)
+    gap = max([s["gap"] for s in bset.seams] + [rep.get("max_curve_deviation", 0.0)]) * diag
+    model = cad.CadModel(
+        curves=[e.curve for e in net.edges], ends=[(e.u, e.v) for e in net.edges],
+        positions=np.asarray(net.positions, np.float64),
+        boundaries=orient_boundaries(net, ps.patches), surfaces=surfaces, pieces=free,
+        piece_patch=[loop_patch[pc.patch] for pc in free], diagonal=diag, gap=gap)
+    out = cad.write_cad(path, model, schema=schema, wires=result.wires)
+    return {"pieces": bset.report, "seams": bset.seams, **out}
 
 
 def _network(sketch, patchset, *, snap_tol, timings):
@@ -251,34 +237,6 @@ def patches(source, *, snap_tol: float | str | None = "auto", close: str = "auto
     return ps
 
 
-#: A patch set matches a sketch when nearly all stroke points and curve points lie within
-#: this fraction of the sketch's diagonal of the other (snapping moves points far less)...
-PATCHES_MATCH_TOL = 0.1
-#: ...all but this share of them (trimmed overshoots and dropped strokes lie farther).
-PATCHES_MATCH_OUTLIERS = 0.1
-
-
-def _check_patches_match(sketch: Sketch, ps: PatchSet) -> None:
-    """Refuse a patch set whose network was not made from ``sketch``."""
-    from scipy.spatial import cKDTree
-    net = ps.network
-    drawn = sketch.select(("boundary", "crease"))
-    drawn = drawn if len(drawn) else sketch
-    strokes = np.concatenate(drawn.strokes)
-    curves = (np.concatenate([e.curve for e in net.edges]) if net.edges
-              else np.asarray(net.positions, np.float64).reshape(-1, 3))
-    diag = drawn.diagonal
-    if len(curves) == 0 or not diag > 0:
-        return
-    far = max(float(np.mean(cKDTree(curves).query(strokes)[0] > PATCHES_MATCH_TOL * diag)),
-              float(np.mean(cKDTree(strokes).query(curves)[0] > PATCHES_MATCH_TOL * diag)))
-    if far > PATCHES_MATCH_OUTLIERS:
-        raise InvalidParameterError(
-            f"the patch set's network does not match the sketch {sketch.source or ''}: "
-            f"{far:.0%} of the points lie farther than {PATCHES_MATCH_TOL:.0%} of the diagonal "
-            "from the other (were the patches made from another sketch?)")
-
-
 def _load(source, patchset: PatchSet | None, points, diag: dict):
     """``(sketch, patch set)`` of the input; a given ``patchset`` must match the sketch."""
     sketch, given = load_source(source, points=points)
@@ -289,7 +247,7 @@ def _load(source, patchset: PatchSet | None, points, diag: dict):
     if patchset is not None:
         given = patchset
         if sketch is not None:
-            _check_patches_match(sketch, patchset)
+            check_patches_match(sketch, patchset)
     if sketch is not None and len(sketch.select(("boundary", "crease"))) == 0:
         raise InvalidParameterError(f"{sketch.source or 'sketch'}: no boundary or crease strokes")
     return sketch, given
@@ -447,6 +405,52 @@ def _surface_route(plan: _Plan, decision: RouteDecision, settings: SurfaceSettin
     return res, name
 
 
+def _judge(plan: _Plan, decision: RouteDecision, settings: SurfaceSettings, close: str, *,
+           sketch, net, ps, res, name, timings, diag):
+    """``auto``'s check of the classical surface, and what it takes when the check fails.
+
+    The surface passes when no patch is a wall inside the shape the others bound
+    (:func:`~curvenet.route.check.judge_patches`). Otherwise the other patch selection
+    (:func:`~curvenet.cycles.find_patches` ``mode="faces"`` or ``"basis"``) is surfaced
+    and judged, and kept if it passes; if neither passes, the neural route surfaces the
+    strokes. Returns ``(result, patch set, decision with its check, name)``.
+    """
+    if getattr(res, "face_patch", None) is None:
+        return res, ps, decision, name
+    creases = [i for i, e in enumerate(net.edges) if e.label == "crease"]
+
+    def judge(r, p):
+        return judge_patches(r.vertices, r.faces, r.face_patch, [q.all_edges for q in p.patches],
+                             net.number_of_edges, creases=creases)
+
+    first = judge(res, ps)
+    mode = ps.report.get("mode", "basis")
+    check = {"walls": {mode: len(first["walls"])}, "nonmanifold": first["nonmanifold"],
+             "taken": mode}
+    if first["passes"]:
+        return res, ps, replace(decision, check=check), name
+    from .cycles.find import find_patches
+    other = "faces" if mode == "basis" else "basis"
+    alt = find_patches(net, close=close, mode=other)
+    if alt.patches:
+        alt_res, alt_name = _surface_route(plan, decision, settings, sketch=sketch, net=net,
+                                           ps=alt, timings=timings, diag=diag)
+        verdict = judge(alt_res, alt)
+        check["walls"][other] = len(verdict["walls"])
+        if verdict["passes"]:
+            check.update(taken=other, nonmanifold=verdict["nonmanifold"])
+            diag["patches"] = len(alt.patches)
+            return alt_res, alt, replace(decision, patches=len(alt.patches), check=check), alt_name
+    strokes, labels = _strokes(sketch, net)
+    res = _run(plan.stroke, SurfaceInput(settings, strokes=strokes, labels=labels),
+               plan.options[plan.stroke.name], timings, diag)
+    check["taken"] = "neural"
+    decision = replace(decision, route=Route.NEURAL, surfacer=plan.stroke.name, reason="judged",
+                       check=check)
+    diag["decision"] = decision.explain()
+    return res, ps, decision, plan.stroke.label
+
+
 def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
             snap_tol: float | str | None = "auto", close: str = "auto",
             surfacer: str = "catmull-clark",
@@ -524,6 +528,9 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
         raise CurvenetError("no patches found: the curves form no cycles; try --method neural")
     res, name = _surface_route(plan, decision, settings, sketch=sketch, net=net, ps=ps,
                                timings=timings, diag=diag)
+    if method == "auto" and decision.route is Route.CLASSICAL and not plan.refine:
+        res, ps, decision, name = _judge(plan, decision, settings, close, sketch=sketch, net=net,
+                                         ps=ps, res=res, name=name, timings=timings, diag=diag)
     if len(res.faces) == 0:
         raise CurvenetError(f"the {name} route produced an empty surface")
     if "regions" in res.report:        # a composite filled in its regions' figures

@@ -34,8 +34,8 @@ traverse shared curves in opposite directions give a consistently oriented mesh.
 Notes
 -----
 The paper treats four-sided loops only; the piece split and the Tutte placement are
-our extension (README.md, "Where we differ from the papers": loops with other than
-four sides are split into quads around a centre).
+our extension (docs/methods.md, "Where we differ from the papers, and why": loops with
+other than four sides are split into quads around a centre).
 """
 
 from __future__ import annotations

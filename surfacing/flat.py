@@ -142,6 +142,9 @@ def _triangulate(xy, rings, spacing):
     from matplotlib.path import Path
     from scipy.spatial import cKDTree
     seg = np.concatenate([np.stack([r, np.roll(r, -1)], 1) for r in rings])
+    if len(np.unique(np.concatenate(rings))) < len(seg):
+        return None             # a loop through a point twice (a seam walked there and
+        #                         back): Triangle's refinement may never end on it
     lo, scale = xy.min(axis=0), float(np.ptp(xy, axis=0).max())
     xy = (xy - lo) / scale      # Triangle reads the area switch as plain decimals
     if cKDTree(xy).query_pairs(_MERGED, output_type="ndarray").size:

@@ -21,10 +21,12 @@ import numpy as np
 
 from curvenet.core.geometry import fit_plane
 
+from .analytic import ANALYTIC_TOL, AnalyticSurface, fit_analytic
 from .api import DEFAULT_EDGE_LENGTH, DEFAULT_MAX_FACES, PatchMeshResult, surface_loops
 from .flat import FLAT_TOL, flat_planes, flatten_planar, loop_points, mesh_flat
 
-__all__ = ["split_holed", "split_boundaries", "surface_boundaries", "UnsplittableFace"]
+__all__ = ["split_holed", "split_boundaries", "surface_boundaries", "analytic_faces",
+           "UnsplittableFace"]
 
 
 def _start(curves, item):
@@ -239,9 +241,66 @@ def split_boundaries(curves, boundaries, samples: int = 17):
     return curves, loops, np.asarray(owner, dtype=np.int64), unsplit
 
 
+def analytic_faces(curves, boundaries, *, tol: float = ANALYTIC_TOL, flat=None, normals=None,
+                   offsets=None) -> list:
+    """The elementary surface each patch's boundary lies on (:func:`fit_analytic`).
+
+    Parameters
+    ----------
+    curves : list of (m_i, 3) float64
+    boundaries : list of list of list of (int, bool)
+        Per patch ``[outer, hole_1, ...]``; a seam curve walked twice counts once.
+    tol : float
+        Fraction of the curves' diagonal.
+    flat, normals, offsets : optional
+        :func:`surfacing.flat.flat_planes` of the same boundaries: flat patches are
+        planes without a fit.
+
+    Returns
+    -------
+    list of AnalyticSurface or None
+        Per patch; None for a free-form boundary.
+    """
+    allpts = np.concatenate([np.asarray(c, float) for c in curves])
+    diag = float(np.linalg.norm(np.ptp(allpts, axis=0))) or 1.0
+    out = []
+    for k, b in enumerate(boundaries):
+        ids = sorted({c for lp in b for c, _ in lp})
+        pts = [np.asarray(curves[c], np.float64) for c in ids]
+        if flat is not None and flat[k]:
+            p = np.concatenate(pts)
+            n = np.asarray(normals[k], np.float64)
+            o = p.mean(axis=0)
+            o = o - (o @ n - offsets[k]) * n
+            res = float(np.abs(p @ n - offsets[k]).max())
+            e = np.eye(3)[int(np.argmin(np.abs(n)))]
+            e = e - (e @ n) * n
+            out.append(AnalyticSurface("plane", o, n, e / np.linalg.norm(e), 0.0, 0.0, res))
+            continue
+        out.append(fit_analytic(pts, tol=tol * diag, diagonal=diag))
+    return out
+
+
+def _on_surfaces(V, F, face_patch, surfaces):
+    """Vertices of the faces of each analytic patch that no other patch uses, projected
+    onto its surface: (n, 3) float64 (a copy)."""
+    V = np.array(V, dtype=np.float64)
+    pairs = np.unique(np.c_[np.asarray(F).ravel(), np.repeat(face_patch, 3)], axis=0)
+    count = np.bincount(pairs[:, 0], minlength=len(V))
+    owner = np.full(len(V), -1, np.int64)
+    owner[pairs[:, 0]] = pairs[:, 1]
+    owner[count > 1] = -1
+    for p, s in enumerate(surfaces):
+        if s is not None:
+            ids = np.flatnonzero(owner == p)
+            V[ids] = s.project(V[ids])
+    return V
+
+
 def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: float = FLAT_TOL,
-                       **options):
-    """:func:`surfacing.surface_loops` for patches that may have holes; flat patches flat.
+                       analytic_tol: float | None = ANALYTIC_TOL, **options):
+    """:func:`surfacing.surface_loops` for patches that may have holes; flat patches flat,
+    analytic patches on their surface.
 
     Parameters
     ----------
@@ -254,6 +313,10 @@ def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: f
         Flatness of a boundary, fraction of the diagonal (:func:`surfacing.flat.flat_planes`):
         flat patches are surfaced over their outer loop, then meshed in their plane
         (:func:`surfacing.flat.mesh_flat`).
+    analytic_tol : float or None
+        Patches whose boundary lies on a plane, cylinder, cone, sphere or torus within
+        this fraction of the diagonal (:func:`analytic_faces`) get their mesh vertices
+        projected onto it; None: no analytic faces (every face as the fit leaves it).
     **options
         Passed to :func:`surfacing.surface_loops` (``crease_curves``, ``resolution``, ...).
 
@@ -262,8 +325,11 @@ def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: f
     PatchMeshResult
         ``face_patch`` indexes ``boundaries``; ``report`` adds ``n_sectors``
         (loops surfaced), ``cuts``, ``flat_patches``, ``flat_meshed`` (those meshed
-        in-plane) and ``unsplit_holes``; ``curves`` (when asked for) holds the input
-        curves only.
+        in-plane), ``unsplit_holes``, ``loop_patch`` (the patch of each loop of the
+        control net, sectors included) and ``analytic``: per patch the
+        :meth:`~surfacing.analytic.AnalyticSurface.to_dict` of its surface (with
+        ``residual`` in model units) or None; ``curves`` (when asked for) holds the
+        input curves only.
     """
     n = len(curves)
     flat, normals, offsets = flat_planes(curves, boundaries, flat_tol)
@@ -278,9 +344,16 @@ def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: f
         V, res.faces, face_patch, res.curve_vertices, curves, boundaries, flat, normals,
         offsets, edge_length=target if auto else None,
         max_faces=max(DEFAULT_MAX_FACES, len(res.faces)) if auto else None)
+    surfaces = [None] * len(boundaries)
+    if analytic_tol is not None:
+        surfaces = analytic_faces(curves, boundaries, tol=analytic_tol, flat=flat,
+                                  normals=normals, offsets=offsets)
+        V = _on_surfaces(V, F, face_patch, surfaces)
     report = dict(res.report, n_patches=len(boundaries), n_sectors=len(loops),
                   cuts=len(all_curves) - n, flat_patches=int(flat.sum()),
-                  flat_meshed=int(meshed.sum()), n_faces=len(F), unsplit_holes=unsplit)
+                  flat_meshed=int(meshed.sum()), n_faces=len(F), unsplit_holes=unsplit,
+                  loop_patch=owner.tolist(),
+                  analytic=[None if s is None else s.to_dict() for s in surfaces])
     new_curves = None if res.curves is None else res.curves[:n]
     return PatchMeshResult(V, F, report, face_patch=face_patch, curves=new_curves,
                            control_vertices=res.control_vertices,

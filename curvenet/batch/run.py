@@ -221,7 +221,7 @@ def _cad_bytes(res, path: Path, out: dict) -> bytes:
     res.save(path)
     cad = res.diagnostics["cad"]
     smooth = [s["angle"] for s in cad["seams"] if not s["crease"]]
-    out.update(cad_faces=cad["pieces"]["n_pieces"], cad_exact=cad["pieces"]["n_exact"],
+    out.update(cad_faces=len(cad["faces"]), cad_exact=cad["pieces"]["n_exact"],
                cad_deviation=cad["pieces"]["max_deviation"],
                cad_gap=max((s["gap"] for s in cad["seams"]), default=0.0),
                cad_g1=max(smooth, default=0.0))

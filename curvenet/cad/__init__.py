@@ -1,7 +1,15 @@
-"""B-rep output: STEP and 3DM through OpenCascade and rhino3dm (the ``[cad]`` extra)."""
+"""B-rep output: STEP and 3DM through OpenCascade and rhino3dm (the ``[cad]`` extra).
 
-from .export import (CAD_FORMATS, STEP_SCHEMAS, manifold_groups, occ_faces, read_step,
-                     require_cad, sew, shape_report, write_3dm, write_cad, write_step)
+:mod:`.brep` builds the shape (shared edges, trimmed analytic faces, B-spline pieces,
+sewn solids), :mod:`.rhino` writes it as a joined 3DM Brep, :mod:`.export` as STEP;
+:mod:`.occ` holds the helpers they share.
+"""
 
-__all__ = ["CAD_FORMATS", "STEP_SCHEMAS", "write_cad", "write_step", "write_3dm", "read_step",
-           "occ_faces", "sew", "manifold_groups", "shape_report", "require_cad"]
+from .brep import CAD_KINDS, CadInputError, CadModel, brep_shape, face_kinds
+from .export import CAD_FORMATS, STEP_SCHEMAS, read_step, write_cad, write_step
+from .occ import require_cad, shape_report
+from .rhino import read_3dm_breps, write_3dm
+
+__all__ = ["CAD_KINDS", "CAD_FORMATS", "STEP_SCHEMAS", "CadModel", "CadInputError", "brep_shape",
+           "face_kinds", "write_cad", "write_step", "write_3dm", "read_step",
+           "read_3dm_breps", "shape_report", "require_cad"]

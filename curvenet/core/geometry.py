@@ -27,6 +27,7 @@ __all__ = [
     "arc_length",
     "arc_length_params",
     "interpolate_polyline",
+    "segment_closest",
     "sample_at",
     "resample_polyline",
     "densify_polyline",
@@ -254,6 +255,33 @@ def densify_polyline(polyline: np.ndarray, max_step: float) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------- triangles
+def segment_closest(p0, p1, q0, q1):
+    """Closest points of segment pairs, batched (Ericson, Real-Time Collision Detection 5.1.9).
+
+    Parameters
+    ----------
+    p0, p1, q0, q1 : (n, 3) float64
+        Segments ``p0 -> p1`` and ``q0 -> q1``.
+
+    Returns
+    -------
+    s, t : (n,) float64 in [0, 1]
+        The closest points are ``p0 + s (p1 - p0)`` and ``q0 + t (q1 - q0)``.
+    """
+    d1, d2, r = p1 - p0, q1 - q0, p0 - q0
+    a = np.maximum(np.einsum("ij,ij->i", d1, d1), DIVISION_GUARD)  # guard: degenerate segments
+    e = np.maximum(np.einsum("ij,ij->i", d2, d2), DIVISION_GUARD)
+    b = np.einsum("ij,ij->i", d1, d2)
+    c = np.einsum("ij,ij->i", d1, r)
+    f = np.einsum("ij,ij->i", d2, r)
+    denom = a * e - b * b
+    par = denom <= 1e-12 * a * e  # parallel (sin^2 of the angle < 1e-12; local): take the start
+    s = np.where(par, 0.0, np.clip((b * f - c * e) / np.where(par, 1.0, denom), 0.0, 1.0))
+    t = (b * s + f) / e
+    s = np.where(t < 0, np.clip(-c / a, 0, 1), np.where(t > 1, np.clip((b - c) / a, 0, 1), s))
+    return s, np.clip(t, 0.0, 1.0)
+
+
 def face_normals_areas(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Unit normals and areas of triangles.
 

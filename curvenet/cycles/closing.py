@@ -57,7 +57,7 @@ def _smallest_in_coset(x: int, null: list) -> int:
 
 
 def closing_suggestions(pool: CandidatePool, patch_edges, *, exclude=(), max_length=None,
-                        backend: str = "bitset", candidates=None):
+                        backend: str = "bitset", candidates=None, faces=frozenset()):
     """Closing patches for a patch set (Sec. 5), best first.
 
     Parameters
@@ -74,6 +74,9 @@ def closing_suggestions(pool: CandidatePool, patch_edges, *, exclude=(), max_len
         GF(2) solver: Python-int elimination, or ``galois`` row reduction (same answers).
     candidates : list of Candidate, optional
         Cycles to consider instead of ``pool.all_candidates``.
+    faces : set of tuple of int
+        Edge sets known to be faces of the surface (:mod:`curvenet.cycles.rotation`):
+        exempt from the overlap filter below.
 
     Returns
     -------
@@ -96,7 +99,7 @@ def closing_suggestions(pool: CandidatePool, patch_edges, *, exclude=(), max_len
     candidates in the span of the patches close a solid; independent ones are
     not closing patches.
 
-    Our addition: a candidate sharing two or more edges and at least half of
+    Our addition: a candidate (not one of ``faces``) sharing two or more edges and at least half of
     the edges of some current patch ``p`` is not suggested. Then ``c + p`` is a
     cycle no longer than ``c``, and ``c`` is bent around ``p`` (two faces of a
     box merged across an edge, a skew hexagon through half of a face); with the
@@ -123,7 +126,7 @@ def closing_suggestions(pool: CandidatePool, patch_edges, *, exclude=(), max_len
         for e in c.edges:
             for i in users.get(e, ()):
                 shared[i] = shared.get(i, 0) + 1
-        if all(n < 2 or 2 * n < plen[i] for i, n in shared.items()):
+        if c.edges in faces or all(n < 2 or 2 * n < plen[i] for i, n in shared.items()):
             kept.append(c)
     cands = kept
     if not cands:
@@ -163,7 +166,7 @@ def _patch_areas(pool, patch_edges) -> np.ndarray:
     return out
 
 
-def auto_close(pool, patch_edges, max_length):
+def auto_close(pool, patch_edges, max_length, *, candidates=None, faces=frozenset()):
     """``close="auto"``: accept closing patches that fill holes or unexplained creases.
 
     Repeatedly takes the best closing suggestion (up to ``max_length`` edges,
@@ -183,6 +186,10 @@ def auto_close(pool, patch_edges, max_length):
         Current patches (not modified).
     max_length : int
         Longest closing cycle accepted.
+    candidates : list of Candidate, optional
+        Cycles considered instead of the pool's :attr:`~CandidatePool.all_candidates`.
+    faces : set of tuple of int
+        Edge sets of faces of the surface (see :func:`closing_suggestions`).
 
     Returns
     -------
@@ -195,7 +202,8 @@ def auto_close(pool, patch_edges, max_length):
     cos_smooth = np.cos(np.deg2rad(_SMOOTH_DEG))
     net = pool.network
     crease = np.array([e.label == "crease" for e in net.edges], dtype=bool)
-    pool_short = [c for c in pool.all_candidates if c.length <= max_length]
+    pool_short = [c for c in (pool.all_candidates if candidates is None else candidates)
+                  if c.length <= max_length]
     if not pool_short:
         return added
     ne = pool.n_edges
@@ -230,7 +238,7 @@ def auto_close(pool, patch_edges, max_length):
             if hole[j] or all(abs(float(normal(users[e][0]) @ normal(users[e][1])))
                               >= cos_smooth for e in c.edges):
                 eligible.append(c)
-        sugg = closing_suggestions(pool, patch_edges, candidates=eligible)
+        sugg = closing_suggestions(pool, patch_edges, candidates=eligible, faces=faces)
         if not sugg:
             break
         patch_edges.append(sugg[0]["edges"])

@@ -28,6 +28,8 @@ from __future__ import annotations
 import time
 
 import numpy as np
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 
 from .basis import greedy_basis
 from .candidates import (DEFAULT_MAX_WORK, ENGINES, NUMBA_MIN_WORK, SEPARATING_EPS, TIE_BREAKS,
@@ -36,17 +38,26 @@ from .closing import auto_close, closing_suggestions
 from ..core.errors import InvalidParameterError
 from .holes import hole_patches
 from .loops import cycle_to_loop, orient_patches
+from .rotation import embedded_faces
+from .seams import seam_patches
 from ..model.network import CurveNetwork
 from ..model.patchset import Patch, PatchSet
 
 __all__ = ["find_patches", "cycle_to_loop", "orient_patches", "closing_suggestions",
            "greedy_basis", "Candidate", "CandidatePool", "SEPARATING_EPS", "TIE_BREAKS",
-           "ENGINES", "DEFAULT_MAX_WORK", "NUMBA_MIN_WORK"]
+           "ENGINES", "DEFAULT_MAX_WORK", "NUMBA_MIN_WORK", "MODES"]
+
+#: Patch selection: ``"basis"`` (the greedy GF(2) basis, Abbasinejad et al. 2011),
+#: ``"faces"`` (the faces of the rotation system the junctions imply, Zhuang et al.
+#: 2013), ``"auto"`` (both; the one closer to a 2-manifold).
+MODES = ("auto", "basis", "faces")
 
 
-def _validate(network, close, tie_break, max_cycle_length, max_work):
+def _validate(network, mode, close, tie_break, max_cycle_length, max_work):
     if not isinstance(network, CurveNetwork):
         raise InvalidParameterError(f"network: expected a CurveNetwork, got {type(network)!r}")
+    if mode not in MODES:
+        raise InvalidParameterError(f"mode: expected one of {MODES}, got {mode!r}")
     if close not in ("auto", "none"):
         raise InvalidParameterError(f"close: expected 'auto' or 'none', got {close!r}")
     if tie_break not in TIE_BREAKS:
@@ -58,14 +69,23 @@ def _validate(network, close, tie_break, max_cycle_length, max_work):
     if not isinstance(max_work, (int, np.integer)) or max_work < 1:
         raise InvalidParameterError(f"max_work: expected a positive integer, got {max_work!r}")
 
-def find_patches(network: CurveNetwork, *, close: str = "auto", tie_break: str = "pca",
+def find_patches(network: CurveNetwork, *, mode: str = "auto", close: str = "auto",
+                 tie_break: str = "pca",
                  max_cycle_length=None, max_work: int = DEFAULT_MAX_WORK,
-                 engine: str = "auto", genus_aware: bool = True, holes: bool = True) -> PatchSet:
-    """Find surface patches: minimum-weight GF(2) cycle basis plus closing patches.
+                 engine: str = "auto", genus_aware: bool = True, holes: bool = True,
+                 seams: bool = True) -> PatchSet:
+    """Find surface patches: the faces of the surface the curves imply.
 
     Parameters
     ----------
     network : CurveNetwork
+    mode : {"auto", "basis", "faces"}
+        ``"basis"``: the minimum-weight GF(2) cycle basis plus closing patches
+        (Abbasinejad et al. 2011). ``"faces"``: the faces of the rotation system the
+        junctions' tangents imply (:func:`curvenet.cycles.rotation.embedded_faces`,
+        after Zhuang et al. 2013), as many as are independent, in the basis's weight
+        order, plus closing patches. ``"auto"`` (default): both, and the one with the
+        smaller manifold defect (see Notes); the basis on ties.
     close : {"auto", "none"}
         ``"none"``: the paper's solid-free basis. ``"auto"`` (default): also
         accept closing patches (Sec. 5) that fill a hole bounded by edges used
@@ -97,6 +117,10 @@ def find_patches(network: CurveNetwork, *, close: str = "auto", tie_break: str =
         Make nested coplanar patches holes of the face around them
         (:func:`curvenet.cycles.holes.hole_patches`; beyond the paper, whose basis
         holds only simple cycles). ``False``: every patch is a disc.
+    seams : bool
+        Add the periodic faces bounded by two loops and a seam curve walked twice (a
+        bore wall drawn with one seam line; :func:`curvenet.cycles.seams.seam_patches`).
+        ``False``: seams stay unused curves.
 
     Returns
     -------
@@ -110,7 +134,8 @@ def find_patches(network: CurveNetwork, *, close: str = "auto", tie_break: str =
         lists), ``tie_break``, ``close``, ``timings`` (``{"patches": seconds}``) and
         ``patch_stages`` (seconds for ``setup``, ``basis``, ``closing``) and
         ``holes`` (which loops became holes of which patch, see
-        :func:`curvenet.cycles.holes.hole_patches`).
+        :func:`curvenet.cycles.holes.hole_patches`) and ``seams`` (the periodic faces
+        added, see :func:`curvenet.cycles.seams.seam_patches`).
 
     Raises
     ------
@@ -163,42 +188,156 @@ def find_patches(network: CurveNetwork, *, close: str = "auto", tie_break: str =
     >>> len(ps.patches), ps.report["rank"], [p.source for p in ps.patches].count("closing")
     (6, 5, 1)
     """
-    _validate(network, close, tie_break, max_cycle_length, max_work)
+    _validate(network, mode, close, tie_break, max_cycle_length, max_work)
     t0 = time.perf_counter()
     kw = dict(close=close, tie_break=tie_break, max_cycle_length=max_cycle_length,
               max_work=max_work, engine=engine)
-    ps = _find_patches(network, genus_aware=genus_aware, **kw)
+    ps, pool = _find_patches(network, genus_aware=genus_aware, **kw)
     if genus_aware:
-        ps = _keep_closer_to_manifold(network, ps, kw)
+        ps, pool = _keep_closer_to_manifold(network, ps, pool, kw)
     else:
         ps.report["manifold_defect"] = {"paper": _manifold_defect(network, ps.patches)}
         ps.report["order"] = "paper"
+    ps.report["mode"] = "basis"
+    if mode != "basis":
+        ps = _choose_faces(network, ps, pool, close, mode, max_cycle_length)
     ps.report["holes"] = []
     if holes:
         ps.patches, ps.report["holes"] = hole_patches(network, ps.patches)
+    ps.report["seams"] = []
+    if seams:
+        ps.patches, ps.report["seams"], ps.report["holes"] = seam_patches(
+            network, ps.patches, ps.report["holes"])
     ps.report["timings"] = {"patches": time.perf_counter() - t0}
     return ps
 
 
-def _keep_closer_to_manifold(network, genus_aware: PatchSet, kw: dict) -> PatchSet:
+def _keep_closer_to_manifold(network, genus_aware: PatchSet, pool, kw: dict):
     """The genus-aware run, or the paper's order when that has no larger manifold defect.
 
-    Sets ``report["manifold_defect"]`` and ``report["order"]`` of the one kept.
+    Sets ``report["manifold_defect"]`` and ``report["order"]`` of the one kept; returns
+    it and its candidate pool.
     """
     score = _manifold_defect(network, genus_aware.patches)
     defect = {"paper": score, "genus_aware": score}
     ps, order = genus_aware, "paper"
     # with no cycle found cutting, the genus-aware run took the paper's order
     if genus_aware.report["cutting_flagged"]:
-        paper = _find_patches(network, genus_aware=False, **kw)
+        paper, paper_pool = _find_patches(network, genus_aware=False, **kw)
         defect["paper"] = _manifold_defect(network, paper.patches)
         if score < defect["paper"]:
             order = "genus_aware"
         else:
-            ps = paper
+            ps, pool = paper, paper_pool
     ps.report["manifold_defect"] = defect
     ps.report["order"] = order
-    return ps
+    return ps, pool
+
+
+def _choose_faces(network, basis: PatchSet, pool, close: str, mode: str,
+                  max_cycle_length=None) -> PatchSet:
+    """The embedded faces' patch set instead of ``basis`` when it is closer to a manifold.
+
+    ``mode="faces"`` takes it whenever the faces give any patch. The one returned holds
+    ``report["mode"]`` and ``report["embedding"]``: the :class:`EmbeddedFaces` figures
+    and ``defect``, the :func:`_surface_defect` of both patch sets.
+    """
+    faces = embedded_faces(network)
+    patches = _face_patches(pool, faces, close, max_cycle_length)
+    defect = {"basis": _surface_defect(network, basis.patches, faces.core),
+              "faces": _surface_defect(network, patches, faces.core)}
+    embedding = dict(faces.report, faces=len(faces.loops),
+                     simple=int(np.count_nonzero(faces.simple)), genus=faces.genus,
+                     defect=defect)
+    clean = bool(faces.simple.all()) and not faces.report["conflicts"]
+    if patches and (mode == "faces" or clean and defect["faces"] <= defect["basis"]
+                    and _covers(patches, basis.patches)):
+        report = dict(basis.report, mode="faces",
+                      closing_added=[list(p.edges) for p in patches if p.source == "closing"],
+                      handle_cycles=[])
+        basis = PatchSet(network, patches, report)
+    basis.report["embedding"] = embedding
+    return basis
+
+
+def _face_patches(pool, faces, close: str, max_cycle_length=None) -> list:
+    """Patches from the simple faces of an embedding.
+
+    The faces are taken greedily in the basis's weight order (length, then the
+    tie-break volume: faces of an embedding are not tested for separating) as long as
+    they are independent over GF(2); with ``close="auto"`` the closing rules of
+    :func:`~curvenet.cycles.closing.auto_close` then consider the other faces and the
+    cycles the basis run enumerated (walls are no faces), up to the longest face kept.
+    """
+    loops = [lp for lp, ok in zip(faces.loops, faces.simple)
+             if ok and (max_cycle_length is None or len(lp) <= max_cycle_length)]
+    ends = [(e.u, e.v) for e in pool.network.edges]
+    by_len: dict = {}
+    for lp in loops:
+        by_len.setdefault(len(lp), []).append(lp)
+    cands = []
+    for _, group in sorted(by_len.items()):
+        edges = np.array([[i for i, _ in lp] for lp in group], np.int64)
+        verts = np.array([[ends[i][0] if f else ends[i][1] for i, f in lp] for lp in group],
+                         np.int64)
+        cands += pool.make_candidates(edges, verts)
+    for c in cands:
+        c.separating = False
+    seen, unique = set(), []
+    for c in sorted(cands, key=lambda c: c.key):
+        if c.edges not in seen:
+            seen.add(c.edges)
+            unique.append(c)
+    kept = _independent_faces(unique, pool.n_edges)
+    added = []
+    if close == "auto" and kept:
+        rest = [c for c in unique if c not in kept] + pool.all_candidates
+        added = auto_close(pool, [c.edges for c in kept], max(c.length for c in kept),
+                           candidates=rest, faces=seen)
+    return [Patch(c.edges, "auto") for c in kept] + [Patch(e, "closing") for e in added]
+
+
+def _independent_faces(faces: list, n_edges: int) -> list:
+    """The faces less the last of each closed group: a GF(2) independent set.
+
+    Each curve bounds at most two faces of an embedding, so a set of them sums to zero
+    only where every curve of it bounds two: a union of *closed* groups (faces joined
+    by shared curves, every curve of the group used twice). Each closed group has that
+    one relation; dropping its last face (``faces`` is in weight order) leaves the rest
+    independent, as the greedy matroid pass would, without an elimination.
+    """
+    if not faces:
+        return []
+    face = np.repeat(np.arange(len(faces)), [c.length for c in faces])
+    edge = np.concatenate([c.edges for c in faces])
+    uses = np.bincount(edge, minlength=n_edges)
+    order = np.argsort(edge, kind="stable")
+    e, f = edge[order], face[order]
+    pair = np.flatnonzero(e[1:] == e[:-1])                  # the two faces of a curve
+    graph = coo_matrix((np.ones(len(pair)), (f[pair], f[pair + 1])),
+                       shape=(len(faces), len(faces)))
+    _, group = connected_components(graph, directed=False)
+    open_group = np.zeros(group.max() + 1, bool)
+    open_group[group[face[uses[edge] != 2]]] = True
+    last = {g: i for i, g in enumerate(group.tolist())}    # the heaviest face per group
+    drop = {i for g, i in last.items() if not open_group[g]}
+    return [c for i, c in enumerate(faces) if i not in drop]
+
+
+def _covers(patches, others) -> bool:
+    """Whether ``patches`` use every curve ``others`` use."""
+    return {e for p in others for e in p.edges} <= {e for p in patches for e in p.edges}
+
+
+def _surface_defect(network: CurveNetwork, patches, core) -> int:
+    """Curves that can bound faces (``core``) but bound no patch, one, or three or more.
+
+    0 for a closed 2-manifold through every curve; an open surface adds its boundary.
+    """
+    uses = np.zeros(network.number_of_edges, dtype=np.int64)
+    for p in patches:
+        uses[list(p.edges)] += 1
+    return int(np.count_nonzero(core & (uses != 2)))
 
 
 def _manifold_defect(network: CurveNetwork, patches) -> int:
@@ -254,4 +393,4 @@ def _find_patches(network, *, close, tie_break, max_cycle_length, max_work, engi
         "timings": {"patches": t3 - t0},
         "patch_stages": {"setup": t1 - t0, "basis": t2 - t1, "closing": t3 - t2},
     }
-    return PatchSet(network, patches, report)
+    return PatchSet(network, patches, report), pool

@@ -49,16 +49,23 @@ def cycle_to_loop(network: CurveNetwork, edge_ids) -> list:
     >>> loop = cycle_to_loop(net, [2, 0, 1, 3])
     >>> sorted(e for e, _ in loop)
     [0, 1, 2, 3]
+
+    Notes
+    -----
+    Edges listed twice are the *seam* of a periodic face (a bore wall bounded by two
+    circles and one seam line): the walk is the first loop from the seam's end on it,
+    the seam, the second loop walked against the first (opposite Newell normals, as
+    the two borders of a band are), and the seam back (:func:`_seam_walk`).
     """
     ids = [int(e) for e in edge_ids]
     ne = network.number_of_edges
     if not ids:
         raise NetworkError("cycle_to_loop: empty edge list")
-    if len(set(ids)) != len(ids):
-        raise NetworkError(f"cycle_to_loop: repeated edge ids in {ids}")
     bad = [e for e in ids if not 0 <= e < ne]
     if bad:
         raise NetworkError(f"cycle_to_loop: edge ids {bad} out of range 0..{ne - 1}")
+    if len(set(ids)) != len(ids):
+        return _seam_walk(network, ids)
     ends = {e: (network.edges[e].u, network.edges[e].v) for e in ids}
     if len(ids) == 1:
         u, v = ends[ids[0]]
@@ -92,6 +99,91 @@ def cycle_to_loop(network: CurveNetwork, edge_ids) -> list:
     if x != ends[start][0]:
         raise NetworkError(f"cycle_to_loop: edges {sorted(ids)} do not close")
     return loop
+
+
+def _seam_walk(network: CurveNetwork, ids: list) -> list:
+    """The closed walk of a periodic face: ``L1, seam, L2, seam reversed``.
+
+    ``ids`` holds the seam's edges twice and the edges of one or two simple loops
+    once; the seam is a path from a junction of the first loop (the one with the
+    smallest edge id) to one of the second, or to a free end (an apex: the walk is then
+    ``L1, seam, seam reversed``).
+
+    Raises
+    ------
+    NetworkError
+        An edge listed more than twice, a seam that is no path between the loops,
+        or loops that are not simple.
+    """
+    count: dict = {}
+    for e in ids:
+        count[e] = count.get(e, 0) + 1
+    if max(count.values()) > 2:
+        raise NetworkError(f"cycle_to_loop: an edge listed more than twice in {sorted(ids)}")
+    seam = sorted(e for e, c in count.items() if c == 2)
+    rest = sorted(e for e, c in count.items() if c == 1)
+    ends = {e: (network.edges[e].u, network.edges[e].v) for e in count}
+    groups = _components(rest, ends)
+    if not 1 <= len(groups) <= 2:
+        raise NetworkError(f"cycle_to_loop: edges {sorted(ids)} are no seam face "
+                           f"({len(groups)} loops beside the seam)")
+    loops = [cycle_to_loop(network, g) for g in groups]
+    on = [{ends[e][0] if f else ends[e][1] for e, f in lp} for lp in loops]
+    deg: dict = {}
+    for e in seam:
+        for x in ends[e]:
+            deg[x] = deg.get(x, 0) + 1
+    tips = sorted(x for x, d in deg.items() if d == 1)
+    start = [x for x in tips if x in on[0]]
+    if len(tips) != 2 or len(start) != 1 or any(ends[e][0] == ends[e][1] for e in seam):
+        raise NetworkError(f"cycle_to_loop: the seam {seam} of {sorted(ids)} is no path "
+                           f"from a loop")
+    a = start[0]
+    b = tips[1] if tips[0] == a else tips[0]
+    if len(loops) == 2 and b not in on[1] or len(loops) == 1 and b in on[0]:
+        raise NetworkError(f"cycle_to_loop: the seam {seam} of {sorted(ids)} does not join "
+                           f"its loops")
+    path, x, left = [], a, set(seam)
+    while left:
+        e = next(e for e in sorted(left) if x in ends[e])
+        fwd = ends[e][0] == x
+        path.append((e, fwd))
+        left.discard(e)
+        x = ends[e][1] if fwd else ends[e][0]
+    walk = _rotated(network, loops[0], a) + path
+    if len(loops) == 2:
+        second = _rotated(network, loops[1], b)
+        if float(newell_normal(network, second) @ newell_normal(network, loops[0])) > 0:
+            second = _rotated(network, [(e, not f) for e, f in reversed(second)], b)
+        walk += second
+    return walk + [(e, not f) for e, f in reversed(path)]
+
+
+def _components(edges, ends) -> list:
+    """Edge groups connected through shared junctions (sorted lists)."""
+    parent = {e: e for e in edges}
+
+    def root(e):
+        while parent[e] != e:
+            e = parent[e]
+        return e
+    at: dict = {}
+    for e in edges:
+        for x in set(ends[e]):
+            if x in at:
+                parent[root(e)] = root(at[x])
+            at[x] = e
+    out: dict = {}
+    for e in edges:
+        out.setdefault(root(e), []).append(e)
+    return sorted(out.values())
+
+
+def _rotated(network, loop, x) -> list:
+    """``loop`` started at the item leaving junction ``x``."""
+    starts = [network.edges[e].u if f else network.edges[e].v for e, f in loop]
+    k = starts.index(x)
+    return loop[k:] + loop[:k]
 
 
 def loop_points(network, loop) -> np.ndarray:

@@ -20,6 +20,8 @@ __all__: list = []
 
 #: surface_loops arguments the pipeline fills from the network and the settings
 _FROM_PIPELINE = ("crease_curves", "crease_angle")
+#: surface_boundaries' own options beside those of surface_loops
+_BOUNDARY_OPTIONS = ("analytic_tol",)
 
 
 def _loops_kwargs(options: dict, settings: SurfaceSettings) -> dict:
@@ -36,7 +38,12 @@ def _check_catmull_clark(options: dict, settings: SurfaceSettings) -> None:
     from ..surfacing import check_loops_options, surface_loops
     params = inspect.signature(surface_loops).parameters.values()
     check_option_names("catmull-clark", options, [p.name for p in params if p.kind is p.KEYWORD_ONLY
-                                            and p.name not in _FROM_PIPELINE])
+                                            and p.name not in _FROM_PIPELINE]
+                       + list(_BOUNDARY_OPTIONS))
+    tol = options.get("analytic_tol", 0.0)
+    if tol is not None and not (isinstance(tol, (int, float)) and 0 <= tol < 1):
+        raise InvalidParameterError(f"analytic_tol: expected a fraction in [0, 1) or None, "
+                                    f"got {tol!r}")
     check_loops_options(**_loops_kwargs(options, settings))
 
 

@@ -115,6 +115,8 @@ REASONS = {
               "is filled per region",
     "unstructured": "patches cover only {coverage:.0%} of the curve length and most of "
                     "the rest spans area: one neural surface",
+    "judged": "{patches} patches cover {coverage:.0%} of the curve length, but every patch "
+              "set leaves walls inside the shape (check below): one neural surface",
 }
 
 
@@ -139,6 +141,11 @@ class RouteDecision:
         The auto threshold the coverage was compared with.
     regions : list of Region
         Per-region routes, the patched region first (empty unless auto chose per region).
+    check : dict or None
+        ``auto``'s judgement of the classical surface (:func:`curvenet.route.check.
+        judge_patches`): ``walls`` (patch mode -> patches inside the shape the others
+        bound), ``nonmanifold`` (curves bounding three or more patches), ``taken`` (the
+        patch mode kept, or ``"neural"``); None when not judged.
 
     Examples
     --------
@@ -153,6 +160,7 @@ class RouteDecision:
     patches: int | None = None
     min_coverage: float = AUTO_MIN_COVERAGE
     regions: list = field(default_factory=list)
+    check: dict | None = None
 
     def __post_init__(self):
         if self.route in Route._value2member_map_:
@@ -161,6 +169,25 @@ class RouteDecision:
     def explain(self) -> str:
         """``"<route>: <why>"``, the sentence ``--explain`` prints."""
         return f"{self.route}: " + REASONS[self.reason].format(**asdict(self))
+
+    def explain_check(self) -> str | None:
+        """The check's line of ``--explain`` (None when the surface was not judged): the
+        walls (patches inside the shape the others bound) of each patch set judged.
+
+        Examples
+        --------
+        >>> d = RouteDecision("classical", "catmull-clark", "covered", 1.0, 9,
+        ...                   check={"walls": {"basis": 2, "faces": 0}, "nonmanifold": 2,
+        ...                          "taken": "faces"})
+        >>> print(d.explain_check())
+        check: walls: basis 2, faces 0; kept the faces patches; 2 curves in 3+ patches
+        """
+        if self.check is None:
+            return None
+        walls = ", ".join(f"{mode} {n}" for mode, n in self.check["walls"].items())
+        taken = self.check["taken"]
+        kept = "took the neural route" if taken == "neural" else f"kept the {taken} patches"
+        return f"check: walls: {walls}; {kept}; {self.check['nonmanifold']} curves in 3+ patches"
 
     def explain_regions(self) -> list:
         """One line per region (:meth:`Region.explain`)."""

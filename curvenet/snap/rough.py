@@ -15,7 +15,7 @@ from .joins import chord_turn, dissolve
 from .merge import components, join_near
 from .overdraw import close_loops, consolidate, merge_slivers
 from .strokes import Strokes, bump, clean, sample
-from ..core.geometry import arc_length, interpolate_polyline
+from ..core.geometry import arc_length, interpolate_polyline, segment_closest
 from ..core.tolerances import DIVISION_GUARD
 from ..model.network import CurveNetwork
 
@@ -174,33 +174,6 @@ def _unchanged(before, after):
 
 
 # --------------------------------------------------------------------------- junctions
-def _seg_seg(p0, p1, q0, q1):
-    """Closest points of segment pairs, batched (Ericson, Real-Time Collision Detection 5.1.9).
-
-    Parameters
-    ----------
-    p0, p1, q0, q1 : (n, 3) float64
-        Segments ``p0 -> p1`` and ``q0 -> q1``.
-
-    Returns
-    -------
-    s, t : (n,) float64 in [0, 1]
-        The closest points are ``p0 + s (p1 - p0)`` and ``q0 + t (q1 - q0)``.
-    """
-    d1, d2, r = p1 - p0, q1 - q0, p0 - q0
-    a = np.maximum(np.einsum("ij,ij->i", d1, d1), DIVISION_GUARD)  # guard: degenerate segments
-    e = np.maximum(np.einsum("ij,ij->i", d2, d2), DIVISION_GUARD)
-    b = np.einsum("ij,ij->i", d1, d2)
-    c = np.einsum("ij,ij->i", d1, r)
-    f = np.einsum("ij,ij->i", d2, r)
-    denom = a * e - b * b
-    par = denom <= 1e-12 * a * e  # parallel (sin^2 of the angle < 1e-12; local): take the start
-    s = np.where(par, 0.0, np.clip((b * f - c * e) / np.where(par, 1.0, denom), 0.0, 1.0))
-    t = (b * s + f) / e
-    s = np.where(t < 0, np.clip(-c / a, 0, 1), np.where(t > 1, np.clip((b - c) / a, 0, 1), s))
-    return s, np.clip(t, 0.0, 1.0)
-
-
 def _candidates(st, samples, con, tol, h):
     """Junction candidates: positions ``(m, 3)``, the two member strokes ``(m, 2) int64``
     and arc parameters on them ``(m, 2) float64`` of each, and the number of closed strokes.
@@ -221,7 +194,7 @@ def _candidates(st, samples, con, tol, h):
         for dj in (-1, 0):
             ia = np.clip(i + di, start[a], start[a + 1] - 2)
             jb = np.clip(j + dj, start[b], start[b + 1] - 2)
-            u, v = _seg_seg(Q[ia], Q[ia + 1], Q[jb], Q[jb + 1])
+            u, v = segment_closest(Q[ia], Q[ia + 1], Q[jb], Q[jb + 1])
             xa = Q[ia] + u[:, None] * (Q[ia + 1] - Q[ia])
             xb = Q[jb] + v[:, None] * (Q[jb + 1] - Q[jb])
             d = np.linalg.norm(xa - xb, axis=1)

@@ -5,6 +5,7 @@ import math
 import numpy as np
 import pytest
 
+from curvenet.core.geometry import segment_closest
 from curvenet.core import (LABELS, arc_length, arc_length_params, as_polyline, boundary_edges,
                            check_labels, check_strokes, cumulative_length, densify_polyline,
                            face_normals_areas, interpolate_polyline, resample_polyline,
@@ -203,3 +204,22 @@ def test_snap_tol_range():
     for bad in (lo, -0.1, hi + 1e-9, float("nan"), float("inf"), "0.01", None, True):
         with pytest.raises(InvalidParameterError, match="snap_tol"):
             check_snap_tol(bad)
+
+
+def test_segment_closest_points_match_brute_force():
+    rng = np.random.default_rng(0)
+    p0, p1, q0, q1 = (rng.normal(size=(300, 3)) for _ in range(4))
+    p1[:20] = p0[:20] + (q1[:20] - q0[:20])  # parallel pairs
+    s, t = segment_closest(p0, p1, q0, q1)
+    d = np.linalg.norm(p0 + s[:, None] * (p1 - p0) - q0 - t[:, None] * (q1 - q0), axis=1)
+    g = np.linspace(0, 1, 301)
+    for k in range(300):
+        A = p0[k] + g[:, None] * (p1[k] - p0[k])
+        B = q0[k] + g[:, None] * (q1[k] - q0[k])
+        brute = np.linalg.norm(A[:, None] - B[None], axis=2).min()
+        assert d[k] <= brute + 1e-12  # never worse than the 301 x 301 grid
+        spacing = (np.linalg.norm(p1[k] - p0[k]) + np.linalg.norm(q1[k] - q0[k])) / 300
+        assert d[k] >= brute - spacing  # and better only by the grid spacing
+
+
+# --------------------------------------------------------------------------- invariants

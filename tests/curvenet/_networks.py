@@ -63,3 +63,44 @@ def true_faces(shape):
 
 def found(ps):
     return {p.edges for p in ps.patches}
+
+
+def bored_prism(sides=6, *, seam=True, through=True, radius=0.5, height=0.8, samples=33):
+    """A regular prism (a hex nut for ``sides=6``) with a round bore drawn as a CAD B-rep
+    has it: two circles, each one closed curve on one junction, and one seam line
+    between them (``seam=False``: no seam). ``through=False``: a blind hole, its
+    bottom circle half way down; nothing closes it but its disc."""
+    ang = 2 * np.pi * np.arange(sides) / sides
+    ring = np.c_[np.cos(ang), np.sin(ang)]
+    bottom = 0.0 if through else height / 2
+    pos = np.array([(x, y, z) for z in (0.0, height) for x, y in ring]
+                   + [(radius, 0, bottom), (radius, 0, height)], float)
+    net = CurveNetwork(pos)
+    s = np.linspace(0, 1, samples)[:, None]
+    for k in (0, sides):
+        for i in range(sides):
+            a, b = k + i, k + (i + 1) % sides
+            net.add_edge(a, b, (1 - s) * pos[a] + s * pos[b])
+    for i in range(sides):
+        net.add_edge(i, i + sides, (1 - s) * pos[i] + s * pos[i + sides])
+    t = np.linspace(0, 2 * np.pi, 2 * samples - 1)
+    for vid in (2 * sides, 2 * sides + 1):
+        z = pos[vid, 2]
+        net.add_edge(vid, vid, np.c_[radius * np.cos(t), radius * np.sin(t), np.full_like(t, z)])
+    if seam:
+        a, b = 2 * sides, 2 * sides + 1
+        net.add_edge(a, b, (1 - s) * pos[a] + s * pos[b])
+    return net
+
+
+def seam_cylinder(radius=0.5, height=1.0, samples=33):
+    """A capped cylinder as a CAD B-rep draws it: two circles and one seam line."""
+    pos = np.array([(radius, 0, 0), (radius, 0, height)], float)
+    net = CurveNetwork(pos)
+    t = np.linspace(0, 2 * np.pi, 2 * samples - 1)
+    for vid in (0, 1):
+        net.add_edge(vid, vid, np.c_[radius * np.cos(t), radius * np.sin(t),
+                                     np.full_like(t, pos[vid, 2])])
+    s = np.linspace(0, 1, samples)[:, None]
+    net.add_edge(0, 1, (1 - s) * pos[0] + s * pos[1])
+    return net

@@ -64,7 +64,7 @@ def test_wires_are_written_beside_the_faces(tmp_path):
     res.save(tmp_path / "w.3dm")
     objs = [o.Geometry for o in rhino3dm.File3dm.Read(str(tmp_path / "w.3dm")).Objects]
     curves = [g for g in objs if isinstance(g, rhino3dm.PolylineCurve)]
-    assert len(objs) == 7 and len(curves) == 1
+    assert len(objs) == 2 and len(curves) == 1          # one joined Brep and the wire
     pts = np.array([[p.X, p.Y, p.Z] for p in (curves[0].Point(i)
                                               for i in range(curves[0].PointCount))])
     assert np.allclose(pts, wire)
@@ -117,7 +117,7 @@ def test_step_round_trip(tmp_path, make, closed, schema):
     back = cad.shape_report(cad.read_step(path))
     n_patches = len(res.patchset.patches)
     assert back["valid"]
-    assert back["faces"] == rep["pieces"]["n_pieces"] == n_patches    # regular: 1 per patch
+    assert back["faces"] == len(rep["faces"]) == n_patches    # one face per patch
     assert back["free_edges"] == (0 if closed else _open_curves(res))
     assert back["solids"] == (1 if closed else 0)
     # these networks have regular control meshes: the faces are the limit surface
@@ -146,43 +146,64 @@ def test_irregular_shapes_graded_pieces_valid_and_close(tmp_path, make):
     back = cad.shape_report(cad.read_step(tmp_path / "s.step"))
     assert back["valid"] and back["free_edges"] == 0 and back["solids"] == 1
     n_patches = len(res.patchset.patches)
-    extra = sum(c - 1 for c in pieces["pieces_per_patch"].values())
-    assert back["faces"] == pieces["n_pieces"] == n_patches + extra
+    flat = {f["patch"] for f in rep["faces"] if f["kind"] == "plane"}
+    extra = sum(c - 1 for p, c in pieces["pieces_per_patch"].items() if int(p) not in flat)
+    assert back["faces"] == len(rep["faces"]) == n_patches + extra
     smooth = [s["angle"] for s in rep["seams"] if not s["crease"]]
     assert max(smooth, default=0.0) < 1.0
     assert 0 < pieces["max_deviation"] < 2e-5 and pieces["n_exact"] < pieces["n_pieces"]
 
 
-def test_flat_faces_with_holes_refuse_cad_in_one_line(tmp_path):
-    """A washer's annular faces are flat: meshed in their plane over a control mesh of
-    the outer loop only, so a B-spline face would fill the hole: refused, no file."""
+def test_flat_faces_with_holes_are_trimmed_planes_of_a_valid_solid(tmp_path):
+    """A washer: two annular planes (outer and inner wires) and eight quarter cylinders,
+    one closed solid with the true volume, in STEP and as one joined 3DM Brep."""
     pytest.importorskip("OCP")
-    from curvenet.core.errors import InvalidParameterError
-    res = surface(shapes.washer().sketch(), method="classical")
-    with pytest.raises(InvalidParameterError, match="2 faces with holes") as err:
-        res.save(tmp_path / "w.step")
-    assert "\n" not in str(err.value) and not (tmp_path / "w.step").exists()
-
-
-@pytest.mark.parametrize("make", [shapes.torus, shapes.l_prism])
-def test_3dm_round_trip(tmp_path, make):
-    """Read back with rhino3dm: one surface per piece, equal to the pieces (so with
-    their measured deviation) on a grid that crosses the graded knots."""
     rhino3dm = pytest.importorskip("rhino3dm")
+    from curvenet import cad
+    res = surface(shapes.washer().sketch(), method="classical")
+    res.save(tmp_path / "w.step")
+    rep = res.diagnostics["cad"]
+    assert sorted(f["kind"] for f in rep["faces"]) == ["cylinder"] * 8 + ["plane"] * 2
+    assert max(f["residual"] for f in rep["faces"]) < 1e-9
+    shape = cad.read_step(tmp_path / "w.step")
+    back = cad.shape_report(shape)
+    assert back["valid"] and back["solids"] == 1 and back["free_edges"] == 0
+    assert cad.face_kinds(shape).count("plane") == 2
+    assert rep["volumes"] == [pytest.approx(np.pi * (1.0 - 0.25) * 0.2, rel=1e-9)]
+    res.save(tmp_path / "w.3dm")
+    (brep,) = cad.read_3dm_breps(tmp_path / "w.3dm")
+    assert isinstance(brep, rhino3dm.Brep) and brep.IsSolid and brep.IsValid
+    assert len(brep.Faces) == 10
+
+
+def test_a_seam_bore_is_one_cylinder_face_of_the_solid(tmp_path):
     pytest.importorskip("OCP")
-    from curvenet.surfacing.bspline import evaluate, extract_bsplines
+    from curvenet import cad
+    from ._networks import bored_prism
+    res = surface(bored_prism(6), method="classical", subdiv=1)
+    res.save(tmp_path / "n.step")
+    rep = res.diagnostics["cad"]
+    back = cad.shape_report(cad.read_step(tmp_path / "n.step"))
+    assert back["valid"] and back["solids"] == 1 and back["faces"] == 9
+    assert [f["kind"] for f in rep["faces"]].count("cylinder") == 1
+    hexagon = 6 * 0.5 * np.sin(np.pi / 3)
+    assert rep["volumes"] == [pytest.approx((hexagon - np.pi * 0.25) * 0.8, rel=1e-9)]
+
+
+@pytest.mark.parametrize("make", [shapes.torus, shapes.house])
+def test_3dm_is_one_joined_closed_brep(tmp_path, make):
+    """The faces of a closed network as one Brep (a closed polysurface), not loose
+    surfaces; its faces lie on the STEP solid's."""
+    pytest.importorskip("rhino3dm")
+    pytest.importorskip("OCP")
+    from curvenet import cad
     res = surface(make().sketch(), method="classical")
     res.save(tmp_path / "t.3dm")
-    model = rhino3dm.File3dm.Read(str(tmp_path / "t.3dm"))
-    srfs = [o.Geometry for o in model.Objects]
-    bset = extract_bsplines(res.control_net)
-    assert len(srfs) == len(bset.pieces) == res.diagnostics["cad"]["pieces"]["n_pieces"]
-    for srf, pc in zip(srfs, bset.pieces):
-        u = np.r_[np.linspace(0, pc.knots_u[-1], 5), 2.0 ** -np.arange(1, 7)]
-        v = np.r_[np.linspace(0, pc.knots_v[-1], 4), 2.0 ** -np.arange(2, 8)]
-        ours = evaluate(pc, np.repeat(u, len(v)), np.tile(v, len(u)))
-        theirs = np.array([[p.X, p.Y, p.Z] for p in (srf.PointAt(a, b) for a in u for b in v)])
-        assert np.abs(ours - theirs).max() < 1e-9
+    breps = cad.read_3dm_breps(tmp_path / "t.3dm")
+    assert len(breps) == 1 and breps[0].IsSolid and breps[0].IsValid
+    assert len(breps[0].Faces) == len(res.diagnostics["cad"]["faces"])
+    assert res.diagnostics["cad"]["file"] == {"breps": 1, "faces": len(breps[0].Faces),
+                                              "solids": 1, "valid": True, "wires": 0}
 
 
 def test_cli_step_explain(tmp_path, capsys):
@@ -192,7 +213,7 @@ def test_cli_step_explain(tmp_path, capsys):
     assert main(["surface", str(src), "-o", str(tmp_path / "b.step"), "--explain",
                  "--no-progress"]) == 0
     out = capsys.readouterr().out
-    assert "cad: 6 B-spline faces (6 exact" in out and "valid True" in out
+    assert "cad: 6 faces (6 plane)" in out and "valid True" in out
     src2 = tmp_path / "sheet.json"
     write_network(src2, shapes.grid_sheet().network)
     rep = tmp_path / "r.json"

@@ -25,6 +25,15 @@ def test_dir_lists_the_lazy_names_before_first_use():
     assert set(curvenet.__all__) <= set(dir(curvenet))
 
 
+def test_dir_shows_public_names_only_and_each_resolves():
+    code = ("import curvenet; names = dir(curvenet); "
+            "print([n for n in names if n.startswith('_') and n != '__version__'], "
+            "[n for n in names if not hasattr(curvenet, n)], 'annotations' in names)")
+    r = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.strip() == "[] [] False"
+
+
 def _dense_sketch(n=20_001):
     t = np.linspace(0, 2 * np.pi, n)
     circle = np.c_[np.cos(t), np.sin(t), 0 * t]

@@ -1,0 +1,433 @@
+"""The B-rep of a surfaced curve network: shared edges, trimmed faces, sewn solids.
+
+One ``TopoDS_Edge`` per network curve, between shared vertices: a line, a circular
+arc (a full circle for a closed curve) or a B-spline approximating its samples
+(:func:`curve_edges`). A patch whose boundary lies on a plane, cylinder, cone, sphere
+or torus (:mod:`curvenet.surfacing.analytic`) becomes that surface trimmed by wires
+of those edges, an outer wire and one per hole, a seam edge twice in one wire
+(:func:`analytic_face`); ``ShapeFix_Face`` computes the curves on the surface. The
+other patches keep their B-spline faces (the Catmull-Clark limit pieces,
+:func:`curvenet.cad.export.occ_faces`). :func:`build_solids` sews all faces per
+manifold piece (faces meeting along the curves they share), turns each closed shell
+into a solid oriented outward (``ShapeFix_Solid``) and checks it
+(``BRepCheck_Analyzer``).
+
+Everything here needs OpenCascade (``cadquery-ocp``, the ``[cad]`` extra) and imports
+it inside the functions.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..core.errors import CurvenetError
+from .occ import free_edge_count, heal, is_valid, occ_faces
+
+__all__ = ["CadInputError", "CadModel", "brep_shape", "curve_edges", "analytic_face",
+           "build_solids", "face_kinds", "manifold_groups", "EDGE_TOL", "LINE_TOL",
+           "SEW_TOL", "CAD_KINDS"]
+
+#: Largest distance of a curve's samples to its B-spline edge, fraction of the diagonal.
+EDGE_TOL = 1e-6
+#: A curve is a line or a circular arc when its samples lie this close to one (fraction of
+#: the curve's extent).
+LINE_TOL = 1e-7
+
+#: Analytic kinds written as trimmed elementary faces. Spheres and tori are written as
+#: their B-spline pieces: OpenCascade's curves-on-surface of arcs on them
+#: (``ShapeFix_Face``) can take the wrong period, trimming the complement of the face.
+CAD_KINDS = ("plane", "cylinder", "cone")
+#: Sewing tolerance as a fraction of the diagonal, never below twice the largest gap
+#: between neighbouring faces' borders.
+SEW_TOL = 1e-6
+
+#: OpenCascade's surface types by the names the report uses.
+_KIND_NAMES = {"GeomAbs_Plane": "plane", "GeomAbs_Cylinder": "cylinder",
+               "GeomAbs_Cone": "cone", "GeomAbs_Sphere": "sphere", "GeomAbs_Torus": "torus",
+               "GeomAbs_BSplineSurface": "bspline"}
+
+
+class CadInputError(CurvenetError):
+    """A face of the network has no valid B-rep (its loop crosses itself, it does not
+    close): bad input, named by its patch."""
+
+
+def _pnt(p):
+    from OCP.gp import gp_Pnt
+    return gp_Pnt(*(float(x) for x in p))
+
+
+def _dir(v):
+    from OCP.gp import gp_Dir
+    return gp_Dir(*(float(x) for x in v))
+
+
+def _straight(c, tol):
+    d = c[-1] - c[0]
+    L = float(np.linalg.norm(d))
+    if L <= 0:
+        return False
+    off = (c - c[0]) - np.outer((c - c[0]) @ (d / L), d / L)
+    return float(np.linalg.norm(off, axis=1).max()) <= tol * L
+
+
+def _arc_edge(c, closed, v0, v1, tol):
+    """A circular arc (full circle when ``closed``) through the samples, or None."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
+    from OCP.gp import gp_Ax2, gp_Circ
+
+    from ..surfacing.analytic import fit_circle
+    got = fit_circle(c, tol=tol)
+    if got is None:
+        return None
+    centre, n, r = got
+    x = c[0] - centre
+    x = x - (x @ n) * n
+    y = np.cross(n, x)
+    ang = np.unwrap(np.arctan2((c - centre) @ y, (c - centre) @ x))
+    if ang[-1] < ang[0]:
+        n = -n
+        ang = -ang
+    if not np.all(np.diff(ang) > -1e-12):
+        return None
+    circ = gp_Circ(gp_Ax2(_pnt(centre), _dir(n), _dir(x)), float(r))
+    mk = BRepBuilderAPI_MakeEdge(circ, v0, v1)
+    if not mk.IsDone():
+        return None
+    if not closed and abs(ang[-1] - ang[0]) >= 2 * np.pi - 1e-9:
+        return None
+    return mk.Edge()
+
+
+def _spline_edge(c, v0, v1, tol):
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge
+    from OCP.GeomAbs import GeomAbs_C2
+    from OCP.GeomAPI import GeomAPI_PointsToBSpline
+    from OCP.OCP.collections import Array1_gp_Pnt
+    arr = Array1_gp_Pnt(1, len(c))
+    for i, p in enumerate(c, 1):
+        arr.SetValue(i, _pnt(p))
+    fit = GeomAPI_PointsToBSpline(arr, 3, 8, GeomAbs_C2, float(tol))
+    return BRepBuilderAPI_MakeEdge(fit.Curve(), v0, v1).Edge()
+
+
+def curve_edges(curves, ends, positions, used, *, diagonal: float) -> dict:
+    """One shared ``TopoDS_Edge`` per used curve.
+
+    Parameters
+    ----------
+    curves : list of (m_i, 3) float64
+        Network curves, each from ``positions[u]`` to ``positions[v]``.
+    ends : list of (int, int)
+        ``(u, v)`` junctions of each curve (``u == v``: a closed curve).
+    positions : (V, 3) float64
+    used : iterable of int
+        The curves some B-rep face is bounded by.
+    diagonal : float
+        Model units of the tolerances.
+
+    Returns
+    -------
+    dict
+        ``{curve id: (TopoDS_Edge, kind)}``, kind ``"line"``, ``"circle"`` or
+        ``"bspline"``; the edges run from ``u`` to ``v``.
+    """
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeEdge, BRepBuilderAPI_MakeVertex
+    used = sorted(set(int(i) for i in used))
+    verts = {}
+    for i in used:
+        for x in ends[i]:
+            if x not in verts:
+                verts[x] = BRepBuilderAPI_MakeVertex(_pnt(positions[x])).Vertex()
+    out = {}
+    for i in used:
+        c = np.asarray(curves[i], np.float64)
+        u, v = ends[i]
+        closed = u == v
+        if not closed and _straight(c, LINE_TOL):
+            out[i] = (BRepBuilderAPI_MakeEdge(verts[u], verts[v]).Edge(), "line")
+            continue
+        arc = _arc_edge(c, closed, verts[u], verts[v], LINE_TOL)
+        if arc is not None:
+            out[i] = (arc, "circle")
+            continue
+        out[i] = (_spline_edge(c, verts[u], verts[v], EDGE_TOL * diagonal), "bspline")
+    return out
+
+
+def _geom_surface(s):
+    """The ``Geom_Surface`` of an :class:`~curvenet.surfacing.analytic.AnalyticSurface`."""
+    from OCP.Geom import (Geom_ConicalSurface, Geom_CylindricalSurface, Geom_Plane,
+                          Geom_SphericalSurface, Geom_ToroidalSurface)
+    from OCP.gp import gp_Ax3
+    ax = gp_Ax3(_pnt(s.origin), _dir(s.axis), _dir(s.xdir))
+    if s.kind == "plane":
+        return Geom_Plane(ax)
+    if s.kind == "cylinder":
+        return Geom_CylindricalSurface(ax, float(s.radius))
+    if s.kind == "cone":
+        return Geom_ConicalSurface(ax, float(s.minor), float(s.radius))
+    if s.kind == "sphere":
+        return Geom_SphericalSurface(ax, float(s.radius))
+    return Geom_ToroidalSurface(ax, float(s.radius), float(s.minor))
+
+
+def _wire(loop, edges):
+    from OCP.BRep import BRep_Builder
+    from OCP.TopoDS import TopoDS, TopoDS_Wire
+    w, b = TopoDS_Wire(), BRep_Builder()
+    b.MakeWire(w)
+    for e, fwd in loop:
+        edge = edges[e][0]
+        b.Add(w, edge if fwd else TopoDS.Edge(edge.Reversed()))
+    w.Closed(True)
+    return w
+
+
+def analytic_face(surface, boundary, edges, *, tolerance: float, name: str):
+    """The elementary surface trimmed by the boundary's wires.
+
+    Parameters
+    ----------
+    surface : AnalyticSurface
+    boundary : list of list of (int, bool)
+        ``[outer, hole_1, ...]`` loops of ``(curve id, forward)``.
+    edges : dict
+        :func:`curve_edges`.
+    tolerance : float
+        Model units: the precision of the wire checks.
+    name : str
+        Names the face in errors (``"patch 4"``).
+
+    Returns
+    -------
+    TopoDS_Face
+
+    Raises
+    ------
+    CadInputError
+        A loop crosses itself on the surface.
+    """
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
+    from OCP.ShapeAnalysis import ShapeAnalysis_Wire
+    from OCP.ShapeFix import ShapeFix_Face
+    wires = [_wire(lp, edges) for lp in boundary]
+    mk = BRepBuilderAPI_MakeFace(_geom_surface(surface), wires[0], True)
+    for w in wires[1:]:
+        mk.Add(w)
+    fx = ShapeFix_Face(mk.Face())
+    fx.SetPrecision(tolerance)
+    fx.Perform()
+    face = fx.Face()
+    for k, w in enumerate(wires):
+        sa = ShapeAnalysis_Wire(w, face, tolerance)
+        if sa.CheckSelfIntersection():
+            where = "outer loop" if k == 0 else f"hole {k}"
+            raise CadInputError(f"{name}: its {where} crosses itself on its {surface.kind}")
+    return face
+
+
+def face_kinds(shape) -> list:
+    """The surface kind of every face of ``shape`` (``"plane"`` ... ``"bspline"``)."""
+    from OCP.BRepAdaptor import BRepAdaptor_Surface
+    from OCP.TopAbs import TopAbs_FACE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+    out = []
+    exp = TopExp_Explorer(shape, TopAbs_FACE)
+    while exp.More():
+        t = BRepAdaptor_Surface(TopoDS.Face(exp.Current())).GetType()
+        out.append(_KIND_NAMES.get(t.name, "other"))
+        exp.Next()
+    return out
+
+
+def _volume(shape) -> float:
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+    g = GProp_GProps()
+    BRepGProp.VolumeProperties_s(shape, g)
+    return float(g.Mass())
+
+
+def build_solids(faces, groups, tolerance: float):
+    """Sew faces per manifold group; closed shells become outward solids.
+
+    Parameters
+    ----------
+    faces : list of TopoDS_Face
+    groups : list of index arrays
+        Faces sewn together (one manifold piece of the surface each).
+    tolerance : float
+        Sewing tolerance, model units.
+
+    Returns
+    -------
+    shape : TopoDS_Compound
+        The solids and the open shells (a lone face as it is).
+    report : dict
+        ``sewing_free_edges`` (edges bounding one face after sewing), ``volumes``
+        (per solid, positive when oriented outward).
+    """
+    from OCP.BRep import BRep_Builder
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
+    from OCP.ShapeFix import ShapeFix_Solid
+    from OCP.TopAbs import TopAbs_SHELL
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS, TopoDS_Compound
+    comp, bld = TopoDS_Compound(), BRep_Builder()
+    bld.MakeCompound(comp)
+    free, volumes = 0, []
+    for group in groups:
+        sw = BRepBuilderAPI_Sewing(tolerance)
+        for i in group:
+            sw.Add(faces[i])
+        sw.Perform()
+        sewn = sw.SewedShape()
+        free += int(sw.NbFreeEdges())
+        exp = TopExp_Explorer(sewn, TopAbs_SHELL)
+        if not exp.More():               # a single face: sewing returns the face itself
+            bld.Add(comp, sewn)
+        while exp.More():
+            shell = TopoDS.Shell(exp.Current())
+            if free_edge_count(shell) == 0:
+                fix = ShapeFix_Solid(BRepBuilderAPI_MakeSolid(shell).Solid())
+                fix.Perform()
+                solid = fix.Shape()
+                volumes.append(_volume(solid))
+                bld.Add(comp, solid)
+            else:
+                bld.Add(comp, shell)
+            exp.Next()
+    return comp, {"sewing_free_edges": free, "volumes": volumes}
+
+
+@dataclass
+class CadModel:
+    """What the B-rep of a surfaced network is made of.
+
+    Attributes
+    ----------
+    curves : list of (m_i, 3) float64
+        The network's curves.
+    ends : list of (int, int)
+        Their junctions ``(u, v)``.
+    positions : (V, 3) float64
+        Junction positions.
+    boundaries : list of list of list of (int, bool)
+        Per patch ``[outer, hole_1, ...]``, oriented as the surface was.
+    surfaces : list of AnalyticSurface or None
+        Per patch: the elementary surface it is (a trimmed face when its kind is one
+        of :data:`CAD_KINDS`), or None; the other patches' B-spline pieces are their
+        faces.
+    pieces : list of BSplinePiece
+        Limit-surface pieces of the other patches.
+    piece_patch : list of int
+        The patch of each piece.
+    diagonal : float
+        Model units of the relative tolerances.
+    gap : float
+        Largest distance between neighbouring faces' borders expected (model units):
+        seam gaps between pieces, the limit surface's deviation from the curves.
+    names : list of str
+        Per patch, how errors name it (default ``"patch i (curves [...])"``).
+    """
+
+    curves: list
+    ends: list
+    positions: np.ndarray
+    boundaries: list
+    surfaces: list
+    pieces: list = field(default_factory=list)
+    piece_patch: list = field(default_factory=list)
+    diagonal: float = 1.0
+    gap: float = 0.0
+    names: list = field(default_factory=list)
+
+    def name(self, k: int) -> str:
+        if self.names:
+            return self.names[k]
+        ids = sorted({e for lp in self.boundaries[k] for e, _ in lp})
+        return f"patch {k} (curves {ids})"
+
+
+def manifold_groups(boundaries) -> list:
+    """Patches joined across curves that exactly two patches share: one group per
+    manifold piece of the surface (a curve bordering three or more patches, a wall
+    between two cells, separates groups).
+
+    Returns
+    -------
+    list of (k,) int64
+        Patch indices per group, in order of their smallest.
+    """
+    n = len(boundaries)
+    parent = np.arange(n)
+
+    def root(i):
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+    users: dict = {}
+    for k, b in enumerate(boundaries):
+        for e in {e for lp in b for e, _ in lp}:
+            users.setdefault(e, []).append(k)
+    for us in users.values():
+        if len(us) == 2:
+            a, b = root(us[0]), root(us[1])
+            parent[a] = b
+    roots = np.array([root(i) for i in range(n)])
+    return [np.flatnonzero(roots == r) for r in dict.fromkeys(roots.tolist())]
+
+
+def brep_shape(model: CadModel):
+    """The B-rep of ``model``: trimmed analytic faces, B-spline pieces, sewn solids.
+
+    Returns
+    -------
+    shape : TopoDS_Compound
+    report : dict
+        ``faces``: per face ``patch``, ``kind`` (``"plane"`` ... ``"bspline"``) and
+        ``residual`` (analytic faces: largest distance of the boundary samples to the
+        surface, fraction of the diagonal); ``edges``: counts per curve kind;
+        ``sew_tolerance`` (model units), ``sewing_free_edges``, ``volumes``,
+        ``manifold_pieces``, ``shape_fixed`` (healed because the sewn shape was not
+        valid).
+
+    Raises
+    ------
+    CadInputError
+        A face whose boundary crosses itself (named by its patch).
+    """
+    diag = model.diagonal if model.diagonal > 0 else 1.0
+    tol = max(SEW_TOL * diag, 2.0 * model.gap)
+    analytic = [k for k, s in enumerate(model.surfaces) if s is not None and s.kind in CAD_KINDS]
+    used = {e for k in analytic for lp in model.boundaries[k] for e, _ in lp}
+    edges = curve_edges(model.curves, model.ends, model.positions, used, diagonal=diag)
+    faces, info, of_patch = [], [], {}
+    for k in analytic:
+        s = model.surfaces[k]
+        of_patch.setdefault(k, []).append(len(faces))
+        faces.append(analytic_face(s, model.boundaries[k], edges, tolerance=tol,
+                                   name=model.name(k)))
+        info.append({"patch": k, "kind": s.kind, "residual": float(s.residual / diag)})
+    for pc, k in zip(occ_faces(model.pieces), model.piece_patch):
+        of_patch.setdefault(int(k), []).append(len(faces))
+        faces.append(pc)
+        info.append({"patch": int(k), "kind": "bspline", "residual": None})
+    groups = [np.array([f for k in g for f in of_patch.get(int(k), [])], np.int64)
+              for g in manifold_groups(model.boundaries)]
+    groups = [g for g in groups if len(g)]
+    shape, rep = build_solids(faces, groups, tol)
+    fixed = not is_valid(shape)
+    if fixed:
+        shape = heal(shape)
+    kinds: dict = {}
+    for _, kind in edges.values():
+        kinds[kind] = kinds.get(kind, 0) + 1
+    rep.update(faces=info, edges=kinds, sew_tolerance=float(tol), manifold_pieces=len(groups),
+               shape_fixed=fixed)
+    return shape, rep

@@ -1,0 +1,460 @@
+"""Analytic faces: the plane, cylinder, cone, sphere or torus a patch's boundary lies on.
+
+A CAD part's faces are mostly elementary surfaces, and a face's boundary curves fix
+them: two coaxial circles and a straight seam lie on one cylinder, three quarter
+circles meeting at right angles on one sphere. :func:`fit_analytic` fits each kind,
+simplest first (plane, cylinder, cone, sphere, torus), to the boundary samples and
+keeps the first whose residual at *every* sample is within the tolerance; a free-form
+boundary fits none and stays a B-spline face. The classical route then puts the
+patch's mesh on that surface (:func:`AnalyticSurface.project`) and the CAD export
+writes the surface itself, trimmed by the boundary curves, so both agree.
+
+Fitting: an algebraic first guess (the plane of least spread; Kasa's linear circle
+fit in the plane normal to an axis for cylinders, its linear extension with a radius
+linear in height for cones, and its meridian-section form for tori; the linear
+sphere fit), then a Levenberg-Marquardt refinement of the geometric distance. Axis
+guesses come from the boundary itself: the directions of its straight curves (a
+cylinder's rulings), the normals of its circular arcs (circles of revolution), and
+its principal directions.
+
+Arrays in, arrays out: this module knows no graph and no CAD kernel.
+
+Notes
+-----
+The boundary alone cannot always tell the surface: two equal coaxial circles lie on
+a cylinder and on a sphere zone. The simplest kind wins, and a periodic face's seam
+(a line on a cylinder, an arc on a sphere) settles it. Radii are bounded by
+:data:`MAX_RADIUS` diagonals, so a nearly flat free-form face is not taken for a
+huge sphere.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from curvenet.core.geometry import fit_plane
+from curvenet.core.tolerances import DIVISION_GUARD
+
+__all__ = ["AnalyticSurface", "fit_analytic", "fit_circle", "KINDS", "ANALYTIC_TOL",
+           "MAX_RADIUS"]
+
+#: Surface kinds, simplest first: the order :func:`fit_analytic` tries them in.
+KINDS = ("plane", "cylinder", "cone", "sphere", "torus")
+#: Largest distance of a boundary sample to the fitted surface, fraction of the diagonal,
+#: for the patch to be that surface.
+ANALYTIC_TOL = 1e-5
+#: Largest radius (cylinder, cone base, sphere, torus) of a fitted surface, in diagonals.
+MAX_RADIUS = 10.0
+#: A curve is straight (a ruling) when its points lie this close to its chord, and a
+#: circular arc when they lie this close to a circle (fractions of the curve's extent).
+CURVE_TOL = 1e-6
+#: Cosine above which two axis guesses count as the same direction.
+SAME_AXIS = 1.0 - 1e-9
+
+
+@dataclass(frozen=True)
+class AnalyticSurface:
+    """An elementary surface in a frame ``origin, xdir, ydir = axis x xdir, axis``.
+
+    Attributes
+    ----------
+    kind : str
+        One of :data:`KINDS`.
+    origin : (3,) float64
+        Plane: a point of it. Cylinder, cone: a point of the axis (for the cone, where
+        the radius is ``radius``). Sphere, torus: the centre.
+    axis : (3,) float64
+        Unit; the plane's normal, the axis of revolution otherwise.
+    xdir : (3,) float64
+        Unit, normal to ``axis``: where the angle parameter starts.
+    radius : float
+        Cylinder, sphere; the cone's radius at ``origin``; the torus's major radius.
+        0 for a plane.
+    minor : float
+        The torus's minor radius; the cone's semi-angle (radians, the radius grows by
+        ``tan(minor)`` per unit along ``axis``); 0 otherwise.
+    residual : float
+        Largest distance of the fitted samples to the surface (model units).
+
+    Examples
+    --------
+    >>> s = AnalyticSurface("sphere", np.zeros(3), np.array([0., 0, 1]), np.array([1., 0, 0]),
+    ...                     2.0, 0.0, 0.0)
+    >>> s.distance(np.array([[3.0, 0, 0]])).tolist(), s.project(np.array([[0, 0, 5.0]])).tolist()
+    ([1.0], [[0.0, 0.0, 2.0]])
+    """
+
+    kind: str
+    origin: np.ndarray
+    axis: np.ndarray
+    xdir: np.ndarray
+    radius: float
+    minor: float
+    residual: float
+
+    @property
+    def ydir(self) -> np.ndarray:
+        """``axis x xdir``: (3,) float64."""
+        return np.cross(self.axis, self.xdir)
+
+    def _local(self, points):
+        """``(rho, z, radial unit (n, 3))``: distance to the axis, height along it."""
+        d = np.asarray(points, np.float64) - self.origin
+        z = d @ self.axis
+        r = d - z[:, None] * self.axis
+        rho = np.linalg.norm(r, axis=1)
+        unit = np.where(rho[:, None] > DIVISION_GUARD, r / np.maximum(rho, DIVISION_GUARD)[:, None],
+                        self.xdir)
+        return rho, z, unit
+
+    def distance(self, points) -> np.ndarray:
+        """Signed distance of ``points`` ``(n, 3)`` to the surface: (n,) float64
+        (positive away from the axis or the centre, along the normal for a plane)."""
+        p = np.asarray(points, np.float64)
+        if self.kind == "plane":
+            return (p - self.origin) @ self.axis
+        if self.kind == "sphere":
+            return np.linalg.norm(p - self.origin, axis=1) - self.radius
+        rho, z, _ = self._local(p)
+        if self.kind == "cylinder":
+            return rho - self.radius
+        if self.kind == "cone":
+            return (rho - self.radius - z * np.tan(self.minor)) * np.cos(self.minor)
+        return np.hypot(rho - self.radius, z) - self.minor
+
+    def project(self, points) -> np.ndarray:
+        """Closest points of the surface to ``points`` ``(n, 3)``: (n, 3) float64.
+
+        Points on the axis (cylinder, cone, torus) or at the centre (sphere) go along
+        ``xdir``; the cone's projection is onto its full double cone.
+        """
+        p = np.asarray(points, np.float64)
+        if self.kind == "plane":
+            return p - self.distance(p)[:, None] * self.axis
+        if self.kind == "sphere":
+            d = p - self.origin
+            n = np.linalg.norm(d, axis=1, keepdims=True)
+            u = np.where(n > DIVISION_GUARD, d / np.maximum(n, DIVISION_GUARD), self.xdir)
+            return self.origin + self.radius * u
+        rho, z, unit = self._local(p)
+        if self.kind == "cylinder":
+            return self.origin + z[:, None] * self.axis + self.radius * unit
+        if self.kind == "cone":
+            t, c, s = np.tan(self.minor), np.cos(self.minor), np.sin(self.minor)
+            # along the generator through the apex side: foot of (rho, z) on rho = R + z t
+            along = (rho - self.radius) * s + z * c          # coordinate along the line
+            zz = along * c
+            rr = self.radius + zz * t
+            return self.origin + zz[:, None] * self.axis + rr[:, None] * unit
+        ring = self.origin + self.radius * unit                 # nearest point of the spine
+        d = p - ring
+        n = np.linalg.norm(d, axis=1, keepdims=True)
+        u = np.where(n > DIVISION_GUARD, d / np.maximum(n, DIVISION_GUARD), self.axis)
+        return ring + self.minor * u
+
+    def to_dict(self) -> dict:
+        """JSON-ready: lists and floats."""
+        return {"kind": self.kind, "origin": self.origin.tolist(), "axis": self.axis.tolist(),
+                "xdir": self.xdir.tolist(), "radius": float(self.radius),
+                "minor": float(self.minor), "residual": float(self.residual)}
+
+    @classmethod
+    def from_dict(cls, d: dict) -> "AnalyticSurface":
+        """Inverse of :meth:`to_dict`."""
+        return cls(d["kind"], np.asarray(d["origin"], np.float64),
+                   np.asarray(d["axis"], np.float64), np.asarray(d["xdir"], np.float64),
+                   float(d["radius"]), float(d["minor"]), float(d["residual"]))
+
+
+# --------------------------------------------------------------------------- frames
+def _unit(v) -> np.ndarray:
+    v = np.asarray(v, np.float64)
+    return v / max(float(np.linalg.norm(v)), DIVISION_GUARD)
+
+
+def _normal_to(axis) -> np.ndarray:
+    """A unit vector normal to ``axis``."""
+    a = _unit(axis)
+    e = np.eye(3)[int(np.argmin(np.abs(a)))]
+    return _unit(e - (e @ a) * a)
+
+
+def _angles(axis) -> np.ndarray:
+    """Polar angles ``(theta, phi)`` of a unit vector."""
+    a = _unit(axis)
+    return np.array([np.arccos(np.clip(a[2], -1.0, 1.0)), np.arctan2(a[1], a[0])])
+
+
+def _from_angles(theta, phi) -> np.ndarray:
+    return np.array([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)])
+
+
+def _in_plane(points, axis, origin):
+    """Coordinates ``(x, y, z)`` of points in a frame with ``z`` along ``axis``."""
+    e1 = _normal_to(axis)
+    e2 = np.cross(axis, e1)
+    d = np.asarray(points) - origin
+    return d @ e1, d @ e2, d @ axis, e1, e2
+
+
+def fit_circle(points, *, tol: float = CURVE_TOL):
+    """The circle a curve's points lie on, if they do.
+
+    Parameters
+    ----------
+    points : (n, 3) float64
+    tol : float
+        Largest distance to the circle (and to its plane), fraction of the points'
+        extent.
+
+    Returns
+    -------
+    (centre (3,), normal (3,), radius) or None
+        None for straight, non-planar or non-circular points, or fewer than 3.
+    """
+    p = np.asarray(points, np.float64)
+    if len(p) < 3:
+        return None
+    ext = float(np.linalg.norm(np.ptp(p, axis=0)))
+    c, n, _ = fit_plane(p)
+    if ext <= 0 or np.abs((p - c) @ n).max() > tol * ext:
+        return None
+    x, y, _, e1, e2 = _in_plane(p, n, c)
+    A = np.c_[2 * x, 2 * y, np.ones_like(x)]
+    sol, *_ = np.linalg.lstsq(A, x * x + y * y, rcond=None)
+    r2 = sol[2] + sol[0] ** 2 + sol[1] ** 2
+    if not r2 > 0:
+        return None
+    r = float(np.sqrt(r2))
+    centre = c + sol[0] * e1 + sol[1] * e2
+    if np.abs(np.hypot(x - sol[0], y - sol[1]) - r).max() > tol * ext or r > 1e3 * ext:
+        return None
+    return centre, n, r
+
+
+def _straight(points, tol: float = CURVE_TOL):
+    """Unit direction of a straight curve, or None."""
+    p = np.asarray(points, np.float64)
+    d = p[-1] - p[0]
+    L = float(np.linalg.norm(d))
+    if L <= 0:
+        return None
+    u = d / L
+    off = (p - p[0]) - np.outer((p - p[0]) @ u, u)
+    return u if np.linalg.norm(off, axis=1).max() <= tol * L else None
+
+
+# --------------------------------------------------------------------------- first guesses
+def _kasa(x, y):
+    """Linear circle fit: ``(cx, cy, r)`` or None."""
+    A = np.c_[2 * x, 2 * y, np.ones_like(x)]
+    sol, *_ = np.linalg.lstsq(A, x * x + y * y, rcond=None)
+    r2 = sol[2] + sol[0] ** 2 + sol[1] ** 2
+    return (sol[0], sol[1], float(np.sqrt(r2))) if r2 > 0 else None
+
+
+def _guess_cylinder(p, axis):
+    o = p.mean(axis=0)
+    x, y, _, e1, e2 = _in_plane(p, axis, o)
+    got = _kasa(x, y)
+    if got is None:
+        return None
+    cx, cy, r = got
+    return np.r_[_angles(axis), o + cx * e1 + cy * e2, r]
+
+
+def _guess_cone(p, axis):
+    """``x^2 + y^2 = 2 cx x + 2 cy y - e + 2 m z + q z^2`` with ``rho = R + k z``."""
+    o = p.mean(axis=0)
+    x, y, z, e1, e2 = _in_plane(p, axis, o)
+    A = np.c_[2 * x, 2 * y, -np.ones_like(x), 2 * z, z * z]
+    sol, *_ = np.linalg.lstsq(A, x * x + y * y, rcond=None)
+    cx, cy, e, m, q = sol
+    r2 = cx * cx + cy * cy - e
+    if not (r2 > 0 and q > 0):
+        return None
+    R = float(np.sqrt(r2))
+    k = float(np.sqrt(q)) * (1.0 if m >= 0 else -1.0)
+    return np.r_[_angles(axis), o + cx * e1 + cy * e2, R, np.arctan(k)]
+
+
+def _guess_sphere(p):
+    A = np.c_[2 * p, np.ones(len(p))]
+    sol, *_ = np.linalg.lstsq(A, (p * p).sum(axis=1), rcond=None)
+    r2 = sol[3] + sol[:3] @ sol[:3]
+    return np.r_[sol[:3], np.sqrt(r2)] if r2 > 0 else None
+
+
+def _guess_torus(p, axis, point):
+    """The meridian section of points about the axis line ``point + t axis`` is a circle."""
+    d = p - point
+    z = d @ axis
+    rho = np.linalg.norm(d - np.outer(z, axis), axis=1)
+    got = _kasa(rho, z)
+    if got is None:
+        return None
+    R, z0, r = got
+    return np.r_[_angles(axis), point + z0 * axis, R, r]
+
+
+# --------------------------------------------------------------------------- residuals
+def _surface(kind, x, residual=0.0) -> AnalyticSurface:
+    """The surface of a parameter vector (see :func:`_residuals`)."""
+    if kind == "sphere":
+        return AnalyticSurface(kind, x[:3], np.array([0.0, 0, 1]), np.array([1.0, 0, 0]),
+                               abs(float(x[3])), 0.0, residual)
+    axis = _from_angles(x[0], x[1])
+    o = np.asarray(x[2:5], np.float64)
+    if kind == "cylinder":
+        o = o - (o @ axis) * axis
+        return AnalyticSurface(kind, o, axis, _normal_to(axis), abs(float(x[5])), 0.0, residual)
+    if kind == "cone":
+        return AnalyticSurface(kind, o, axis, _normal_to(axis), float(x[5]), float(x[6]),
+                               residual)
+    return AnalyticSurface(kind, o, axis, _normal_to(axis), abs(float(x[5])), abs(float(x[6])),
+                           residual)
+
+
+def _rebased(s: AnalyticSurface, p) -> AnalyticSurface:
+    """A cone's axis turned the way its radius grows (a positive semi-angle), and its
+    origin moved along it to the samples' mean height, where the radius is positive
+    (the frame OpenCascade's conical surface needs)."""
+    if s.kind != "cone":
+        return s
+    sign = 1.0 if s.minor >= 0 else -1.0
+    axis = sign * s.axis
+    zm = float(((p - s.origin) @ axis).mean())
+    return AnalyticSurface("cone", s.origin + zm * axis, axis, s.xdir,
+                           float(s.radius + zm * np.tan(abs(s.minor))), abs(s.minor),
+                           s.residual)
+
+
+def _refine(kind, x0, p):
+    """Levenberg-Marquardt on the geometric distance; ``(x, max |residual|)``."""
+    from scipy.optimize import least_squares
+
+    def f(x):
+        return _surface(kind, x).distance(p)
+    if len(p) <= len(x0):
+        return x0, float(np.abs(f(x0)).max())
+    try:
+        sol = least_squares(f, x0, method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15,
+                            max_nfev=40 * len(x0))
+        x = sol.x
+    except (ValueError, np.linalg.LinAlgError):     # singular start: keep the guess
+        x = x0
+    return x, float(np.abs(f(x)).max())
+
+
+#: Guesses refined per kind (best first by their own residual)...
+REFINED_GUESSES = 2
+#: ...and only those whose RMS distance is under this fraction of the samples' extent.
+GUESS_SCREEN = 0.05
+#: Samples the refinement uses at most (evenly picked; the check uses all).
+REFINE_SAMPLES = 256
+
+
+def _refined(kind, p, guesses, tol):
+    """``(x, max |residual| over all p)`` of the best guesses, refined; stops at the
+    first within ``tol``."""
+    if not guesses:
+        return
+    ext = float(np.linalg.norm(np.ptp(p, axis=0)))
+    rms = [float(np.sqrt(np.mean(_surface(kind, g).distance(p) ** 2))) for g in guesses]
+    order = [i for i in np.argsort(rms)[:REFINED_GUESSES] if rms[i] <= GUESS_SCREEN * ext]
+    sub = p[np.linspace(0, len(p) - 1, min(len(p), REFINE_SAMPLES)).astype(int)]
+    for i in order:
+        x, _ = _refine(kind, guesses[i], sub)
+        res = float(np.abs(_surface(kind, x).distance(p)).max())
+        yield x, res
+        if res <= tol:
+            return
+
+
+def _axis_guesses(p, curves) -> list:
+    """Unit axis guesses: straight curves' directions, arcs' normals, principal axes."""
+    out, lines, arcs = [], [], []
+    for c in curves:
+        u = _straight(c)
+        if u is not None:
+            lines.append(u)
+            continue
+        got = fit_circle(c)
+        if got is not None:
+            arcs.append(got)
+    out += lines + [n for _, n, _ in arcs]
+    out += list(np.linalg.svd(p - p.mean(axis=0), full_matrices=False)[2])
+    uniq = []
+    for a in out:
+        a = _unit(a)
+        if not any(abs(a @ b) > SAME_AXIS for b in uniq):
+            uniq.append(a)
+    return uniq, arcs
+
+
+def _candidates(kind, p, axes, arcs):
+    """First guesses of one kind's parameter vector."""
+    if kind == "sphere":
+        g = _guess_sphere(p)
+        return [] if g is None else [g]
+    if kind == "cylinder":
+        return [g for g in (_guess_cylinder(p, a) for a in axes) if g is not None]
+    if kind == "cone":
+        return [g for g in (_guess_cone(p, a) for a in axes) if g is not None]
+    lines = [(c, n) for c, n, _ in arcs] + [(p.mean(axis=0), a) for a in axes]
+    return [g for g in (_guess_torus(p, _unit(n), c) for c, n in lines) if g is not None]
+
+
+def fit_analytic(curves, *, tol: float, diagonal: float, kinds=KINDS):
+    """The simplest elementary surface all of a boundary's samples lie on.
+
+    Parameters
+    ----------
+    curves : list of (m_i, 3) float64
+        The boundary curves (every loop of the patch, a seam once).
+    tol : float
+        Largest distance of any sample to the surface, model units.
+    diagonal : float
+        The model's diagonal: radii above :data:`MAX_RADIUS` times it are refused.
+    kinds : sequence of str
+        Kinds tried, in this order (default :data:`KINDS`).
+
+    Returns
+    -------
+    AnalyticSurface or None
+        The first kind within ``tol`` (its ``residual`` the largest distance), or None.
+
+    Examples
+    --------
+    >>> t = np.linspace(0, 2 * np.pi, 33)
+    >>> top = np.c_[np.cos(t), np.sin(t), np.ones_like(t)]
+    >>> seam = np.c_[np.ones(5), np.zeros(5), np.linspace(1, 0, 5)]
+    >>> s = fit_analytic([top, top - [0, 0, 1], seam], tol=1e-6, diagonal=3.0)
+    >>> s.kind, round(s.radius, 9)
+    ('cylinder', 1.0)
+    """
+    curves = [np.asarray(c, np.float64) for c in curves]
+    p = np.concatenate(curves)
+    if len(p) < 3:
+        return None
+    c, n, _ = fit_plane(p)
+    axes, arcs = None, None
+    for kind in kinds:
+        if kind == "plane":
+            res = float(np.abs((p - c) @ n).max())
+            if res <= tol:
+                return AnalyticSurface("plane", c, _unit(n), _normal_to(n), 0.0, 0.0, res)
+            continue
+        if axes is None:
+            axes, arcs = _axis_guesses(p, curves)
+        best = None
+        for x, res in _refined(kind, p, _candidates(kind, p, axes, arcs), tol):
+            if best is None or res < best[1]:
+                best = (x, res)
+        if best is not None and best[1] <= tol:
+            s = _rebased(_surface(kind, best[0], best[1]), p)
+            if max(abs(s.radius), s.minor if kind == "torus" else 0.0) <= MAX_RADIUS * diagonal:
+                return s
+    return None

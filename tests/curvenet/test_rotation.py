@@ -1,0 +1,101 @@
+"""Faces of the rotation system the junctions imply (curvenet.cycles.rotation), and the
+patch finder's choice between them and the cycle basis."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from curvenet.cycles import find_patches
+from curvenet.cycles.rotation import embedded_faces
+from curvenet.datasets import sections, shapes
+from curvenet.model.network import CurveNetwork
+
+
+def _found(ps):
+    return {tuple(sorted(p.edges)) for p in ps.patches}
+
+
+@pytest.mark.parametrize("m, n", [(3, 2), (4, 2), (3, 4), (5, 3), (6, 4)])
+@pytest.mark.parametrize("minor", [0.25, 0.6])
+def test_sparse_tori_give_exactly_their_faces(m, n, minor):
+    shape = shapes.torus(1.0, minor, n_u=m, n_v=n)
+    faces = embedded_faces(shape.network)
+    assert sorted(faces.edge_sets) == shape.face_edge_sets()
+    assert faces.simple.all() and faces.genus == [1] and faces.report["conflicts"] == 0
+    # the patch finder keeps them: every curve bounds exactly two patches
+    assert _found(find_patches(shape.network)) == set(shape.face_edge_sets())
+
+
+def test_the_basis_alone_caps_the_meridians_of_a_sparse_torus():
+    # Abbasinejad's mode: a meridian (2 curves) is shorter than every face (4 curves)
+    shape = shapes.torus(n_u=4, n_v=2)
+    basis = find_patches(shape.network, mode="basis")
+    assert _found(basis) != set(shape.face_edge_sets())
+    uses = np.bincount([e for p in basis.patches for e in p.edges],
+                       minlength=shape.network.number_of_edges)
+    assert (uses >= 3).any()                         # walls inside the tube
+    auto = find_patches(shape.network)
+    defect = auto.report["embedding"]["defect"]
+    assert auto.report["mode"] == "faces" and defect["faces"] == 0 < defect["basis"]
+
+
+@pytest.mark.parametrize("name", ["box", "l_prism", "house", "sphere", "ellipsoid",
+                                  "capped_cylinder", "grid_box"])
+def test_genus_zero_shapes_give_their_faces_and_keep_the_basis(name):
+    shape = shapes.SHAPES[name]()
+    faces = embedded_faces(shape.network)
+    assert sorted(faces.edge_sets) == shape.face_edge_sets() and faces.genus == [0]
+    ps = find_patches(shape.network)
+    assert ps.report["mode"] == "basis" and _found(ps) == set(shape.face_edge_sets())
+
+
+def test_an_open_sheet_has_its_faces_and_its_rim():
+    shape = shapes.grid_sheet(3)
+    faces = embedded_faces(shape.network)
+    rim = [f for f in faces.edge_sets if f not in set(shape.face_edge_sets())]
+    assert len(faces.loops) == 10 and len(rim) == 1 and len(rim[0]) == 12
+    # the rim is no patch: closing considers no cycle longer than the faces kept
+    assert _found(find_patches(shape.network)) == set(shape.face_edge_sets())
+
+
+def test_faces_do_not_depend_on_vertex_or_edge_order():
+    shape = shapes.torus(n_u=3, n_v=4)
+    net = shape.network
+    rng = np.random.default_rng(1)
+    vperm = rng.permutation(net.number_of_vertices)
+    eperm = rng.permutation(net.number_of_edges)
+    moved = CurveNetwork(net.positions[np.argsort(vperm)])
+    for i in eperm:
+        e = net.edges[i]
+        moved.add_edge(int(vperm[e.u]), int(vperm[e.v]), e.curve)
+    back = {tuple(sorted(int(eperm[i]) for i in f)) for f in embedded_faces(moved).edge_sets}
+    assert back == set(shape.face_edge_sets())
+
+
+def test_free_ends_bound_no_face():
+    shape = shapes.torus(n_u=4, n_v=2)
+    net = shape.network
+    tip = net.add_vertex(net.positions[0] + [0.0, 0.0, 0.5])
+    net.add_edge(0, tip, np.linspace(net.positions[0], net.positions[tip], 5))
+    faces = embedded_faces(net)
+    assert faces.report["dangling"] == 1 and not faces.core[-1]
+    assert sorted(faces.edge_sets) == shape.face_edge_sets()
+
+
+@pytest.mark.parametrize("shape, genus", [(sections.great_circles(3), 0),
+                                          (sections.great_circles(4), 0),
+                                          (sections.capsule(), 0),
+                                          (sections.double_torus(), 2)])
+def test_section_wireframes_embed_with_their_genus(shape, genus):
+    faces = embedded_faces(shape.network)
+    assert faces.simple.all() and faces.genus == [genus]
+    net = shape.network
+    # every section lies on the surface and meets the others at shared junctions
+    ref = shape.reference_mesh(3)
+    from curvenet.core.distance import point_surface_distance
+    d = point_surface_distance(np.concatenate([e.curve for e in net.edges]), ref.vertices,
+                               ref.faces)[0]
+    assert d.max() < 5e-3 * net.diagonal
+    deg = np.bincount(net.endpoints.ravel(), minlength=net.number_of_vertices)
+    assert (deg == 4).all()

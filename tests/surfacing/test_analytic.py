@@ -1,0 +1,124 @@
+"""Analytic faces: fits of planes, cylinders, cones, spheres and tori to boundary curves."""
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from curvenet.surfacing.analytic import AnalyticSurface, fit_analytic, fit_circle
+from curvenet.surfacing.sectors import surface_boundaries
+
+T = np.linspace(0, 2 * np.pi, 33)
+Q = np.linspace(0, np.pi / 2, 17)
+S = np.linspace(0, 1, 17)
+
+
+def _circle(r, z):
+    return np.c_[r * np.cos(T), r * np.sin(T), np.full_like(T, z)]
+
+
+def _line(a, b):
+    return np.asarray(a, float) + S[:, None] * (np.asarray(b, float) - a)
+
+
+#: boundary curves of one face of each kind, and the parameters they imply
+FACES = {
+    "plane": ([_circle(1.0, 0.0)], {}),
+    # a bore wall: two circles and the seam line between them
+    "cylinder": ([_circle(1.0, 1.0), _circle(1.0, 0.0), _line((1, 0, 1), (1, 0, 0))],
+                 {"radius": 1.0}),
+    # a quarter-round fillet along x: two lines and two quarter arcs
+    "cylinder-fillet": ([np.c_[0 * Q, 0.2 * np.cos(Q), 0.2 * np.sin(Q)],
+                         _line((0, 0.2, 0), (1, 0.2, 0)),
+                         np.c_[1 + 0 * Q, 0.2 * np.cos(Q), 0.2 * np.sin(Q)],
+                         _line((0, 0, 0.2), (1, 0, 0.2))], {"radius": 0.2}),
+    # a countersink: a frustum of semi-angle atan(0.5)
+    "cone": ([_circle(1.0, 1.0), _circle(0.5, 0.0), _line((1, 0, 1), (0.5, 0, 0))],
+             {"minor": np.arctan(0.5)}),
+    # a rounded box corner: three quarter circles at right angles
+    "sphere": ([np.c_[np.cos(Q), np.sin(Q), 0 * Q], np.c_[0 * Q, np.cos(Q), np.sin(Q)],
+                np.c_[np.sin(Q), 0 * Q, np.cos(Q)]], {"radius": 1.0}),
+    # a revolved fillet: two parallels and a meridian quarter arc as the seam
+    "torus": ([_circle(2.0, 0.5), _circle(2.5, 0.0),
+               np.c_[2 + 0.5 * np.cos(Q), 0 * Q, 0.5 * np.sin(Q)]],
+              {"radius": 2.0, "minor": 0.5}),
+}
+
+
+def _moved(curves, seed=3):
+    R = Rotation.from_rotvec(np.random.default_rng(seed).normal(size=3))
+    return [R.apply(c) * 7.0 + [1.0, -2.0, 3.0] for c in curves], 7.0
+
+
+@pytest.mark.parametrize("name", sorted(FACES))
+def test_each_kind_is_found_exactly_in_any_frame(name):
+    curves, params = FACES[name]
+    curves, scale = _moved(curves)
+    s = fit_analytic(curves, tol=1e-9 * scale, diagonal=5.0 * scale)
+    assert s is not None and s.kind == name.split("-")[0]
+    # the residual is measured at every sample, and the surface is the true one
+    assert s.residual < 1e-9 * scale
+    assert np.abs(s.distance(np.concatenate(curves))).max() == pytest.approx(s.residual)
+    for key, value in params.items():
+        length = key == "radius" or name == "torus"      # a cone's minor is an angle
+        want = value * (scale if length else 1.0)
+        assert getattr(s, key) == pytest.approx(want, rel=1e-9)
+
+
+def test_a_saddle_boundary_is_no_elementary_surface():
+    # four lines of the hyperbolic paraboloid z = x y / 2: on none of the kinds
+    u = np.linspace(-1, 1, 17)
+    curves = [np.c_[u, -1 + 0 * u, -u / 2], np.c_[1 + 0 * u, u, u / 2],
+              np.c_[u, 1 + 0 * u, u / 2], np.c_[-1 + 0 * u, u, -u / 2]]
+    assert fit_analytic(curves, tol=1e-5, diagonal=3.0) is None
+
+
+def test_a_slightly_bent_curve_is_refused_at_the_tolerance():
+    curves = [c.copy() for c in FACES["cylinder"][0]]
+    curves[2][8, 0] += 1e-4                     # one seam sample off the cylinder by 1e-4
+    assert fit_analytic(curves, tol=1e-5, diagonal=2.0, kinds=("cylinder",)) is None
+    assert fit_analytic(curves, tol=2e-4, diagonal=2.0, kinds=("cylinder",)).kind == "cylinder"
+
+
+def test_huge_radii_are_refused():
+    # a shallow arc of radius 1000 on a face of size 1 is taken for no cylinder
+    a = np.linspace(-5e-4, 5e-4, 17)
+    arc = np.c_[1000 * np.sin(a), 1000 * (np.cos(a) - 1), 0 * a]
+    curves = [arc, arc + [0, 0, 1], _line(arc[-1], arc[-1] + [0, 0, 1])]
+    assert fit_analytic(curves, tol=1e-9, diagonal=1.5, kinds=("cylinder",)) is None
+
+
+@pytest.mark.parametrize("name", ["cylinder", "cone", "sphere", "torus"])
+def test_projection_lands_on_the_surface_and_is_closest(name):
+    curves, _ = FACES[name]
+    s = fit_analytic(curves, tol=1e-9, diagonal=5.0)
+    rng = np.random.default_rng(0)
+    p = np.concatenate(curves) + rng.normal(scale=0.05, size=(sum(map(len, curves)), 3))
+    q = s.project(p)
+    assert np.abs(s.distance(q)).max() < 1e-12
+    # the closest point: as far as the signed distance says
+    assert np.allclose(np.linalg.norm(p - q, axis=1), np.abs(s.distance(p)), atol=1e-12)
+
+
+def test_round_trip_of_the_dict():
+    s = fit_analytic(FACES["torus"][0], tol=1e-9, diagonal=5.0)
+    t = AnalyticSurface.from_dict(s.to_dict())
+    p = np.random.default_rng(1).normal(size=(10, 3))
+    assert np.array_equal(s.distance(p), t.distance(p))
+
+
+def test_fit_circle_tells_arcs_from_lines():
+    c, n, r = fit_circle(FACES["torus"][0][2])
+    assert r == pytest.approx(0.5) and abs(n[1]) == pytest.approx(1.0)
+    assert fit_circle(_line((0, 0, 0), (1, 2, 3))) is None
+
+
+def test_a_bore_wall_mesh_lies_on_its_cylinder():
+    """A tube with one seam (the loop walks the seam twice): the Catmull-Clark fit sinks
+    between the circles; the analytic face puts the mesh back on the cylinder."""
+    top, bottom, seam = _circle(1.0, 1.0), _circle(1.0, 0.0), _line((1, 0, 1), (1, 0, 0))
+    boundary = [[[(0, True), (2, True), (1, False), (2, False)]]]
+    free = surface_boundaries([top, bottom, seam], boundary, analytic_tol=None, subdiv=2)
+    on = surface_boundaries([top, bottom, seam], boundary, subdiv=2)
+    assert np.abs(np.hypot(*free.vertices[:, :2].T) - 1).max() > 0.05
+    assert np.abs(np.hypot(*on.vertices[:, :2].T) - 1).max() < 1e-12
+    assert on.report["analytic"][0]["kind"] == "cylinder"
