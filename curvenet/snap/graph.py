@@ -32,7 +32,10 @@ Pipeline of :func:`snap` (``mode="rough"``)
    host moves halfway onto the guest there (an average, tapered at both ends),
    so no sliver cycle remains. Repeated until no overdraw is left. A contact
    that touches both ends of a nearly closed stroke (a short stroke drawn over
-   its opening) is split where it jumps between them.
+   its opening) is split where it jumps between them; a host that a guest piece
+   extends past its own start, its end within ``tol`` of the start in its last
+   ``3 tol``, is cut back there (a run past the start too short for the loop rule
+   above, under a sample spacing, is otherwise left overlapping its start).
 4. Every other contact is a junction candidate at its closest sample pair:
    the midpoint for a crossing or two ends (gap), the point on the other stroke
    for an end touching a stroke interior (T-junction). A stroke whose two ends

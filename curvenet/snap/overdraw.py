@@ -112,7 +112,11 @@ def consolidate(st, samples, con, tol, h, opts, report):
                 before = [_cut(gp, gc, gh, gc[-1])[::-1][:-1]]
             elif join["head"] == "left" and gh > 0:
                 before = [_cut(gp, gc, 0.0, gh)[:-1]]
-        st.set(host, clean(np.vstack(before + [hp] + after), 0.05 * tol))
+        poly = clean(np.vstack(before + [hp] + after), 0.05 * tol)
+        if before or after:  # a guest piece continues the host: maybe past its own start
+            loop = _close_loop(poly, cumulative_length(poly), tol)
+            poly = poly if loop is None else loop
+        st.set(host, poly)
         removed.add(guest)
         report["overdraw_consolidations"] += 1
     if not busy:
@@ -208,6 +212,29 @@ def close_loops(st, samples, tol, h, opts, report):
         merged += 1
     report["overdrawn_loops"] += merged
     return merged
+
+
+def _close_loop(poly, cum, tol):
+    """Cut back an end that runs on past the stroke's own start; None if not a loop.
+
+    A polyline longer than ``4 tol`` is a loop when some point of its last ``3 tol``
+    comes within ``tol`` of its start, heading the way the start does (within 60
+    degrees; a stroke doubling back over its start is no loop). It is cut at the
+    closest such point, so a loop that runs past its start (a host extended by a
+    guest piece) leaves at most a gap, as a closed stroke does.
+    """
+    if cum[-1] <= 4.0 * tol:
+        return None
+    tail = np.flatnonzero(cum >= cum[-1] - 3.0 * tol)
+    d = np.linalg.norm(poly[tail] - poly[0], axis=1)
+    q = int(tail[np.argmin(d)])
+    if d.min() > tol:
+        return None
+    head = poly[np.searchsorted(cum, tol)] - poly[0]
+    back = poly[q] - poly[np.searchsorted(cum, cum[q] - tol)]
+    if head @ back <= 0.5 * np.linalg.norm(head) * np.linalg.norm(back):
+        return None
+    return poly[:q + 1]
 
 
 def _merge_own(poly, cum, a, b, tail, tol, blend):
