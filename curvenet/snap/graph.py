@@ -25,7 +25,9 @@ Pipeline of :func:`snap` (``mode="rough"``)
    the average with the C1 bumps of step 6. Checked again after each overdraw
    round (a ring drawn in two pieces, the second run past the first's start, is
    one stroke by then). A stroke that spirals (its ends farther than ``tol`` from
-   the other end's stretch) or folds back over itself stays as drawn.
+   the other end's stretch) or folds back over itself stays as drawn. An end of
+   another stroke that touched only the stretches, and that the average leaves out
+   of reach, moves with them (C1 bump).
    Overdraw: a contact longer than ``overdraw_length * tol`` on both strokes,
    with tangents within ``overdraw_angle``, is one curve drawn twice. The
    stroke more covered by it (the guest) loses the overlapping stretch; the

@@ -195,6 +195,7 @@ def close_loops(st, samples, tol, h, opts, report):
                           & (b > 4.0 * tol))
     cos_od = np.cos(np.radians(opts.overdraw_angle))
     merged = 0
+    moved = []
     for k in cand.tolist():
         run = slice(start[k], start[k + 1])
         head, tail = ss[run] <= a[k], ss[run] >= b[k]
@@ -209,9 +210,60 @@ def close_loops(st, samples, tol, h, opts, report):
         if area < _LOOP_AREA * tol * b[k]:
             continue  # a stroke folded over itself, a thin scribble
         st.set(k, _merge_own(st.polys[k], st.cums[k], a[k], b[k], qt, tol, opts.blend))
+        moved.append((k, np.vstack([qh, qt]),
+                      0.5 * np.vstack([_project(qh, qt) - qh, _project(qt, qh) - qt])))
         merged += 1
+    if moved:
+        _follow(st, samples, moved, tol, opts.blend)
     report["overdrawn_loops"] += merged
     return merged
+
+
+def _follow(st, samples, moved, tol, blend):
+    """Move the ends of other strokes that touch a merged loop's stretches along with them.
+
+    ``samples``: those of :func:`close_loops` (before the merge); ``moved``: per loop,
+    its stroke id, the samples ``(n, 3)`` of its two stretches before the merge and
+    their displacements ``(n, 3)`` onto the average. An end of another stroke (not
+    itself merged) within ``tol`` of those samples, which the average leaves farther
+    than ``tol`` from the loop and which touches no other stroke nor its own other end
+    (an end still in touch, closing a gap or a ring's seam, or at a crossing, stays), is
+    moved by the displacement of the nearest sample, tapered along its stroke by the C1
+    bump of the junction step over ``R = min(blend tol, 0.45 L)``: a stroke that
+    touched only the run past the start stays in touch with the loop (cassie 02-2-1: a
+    stroke starting 0.95 tol from a ring's run past its start was 1.1 tol from the
+    average, and dangled).
+    """
+    done = {k for k, _, _ in moved}
+    others = [j for j in range(len(st)) if j not in done]
+    if not others:
+        return
+    ends = np.array([[st.polys[j][0], st.polys[j][-1]] for j in others]).reshape(-1, 3)
+    shift = np.zeros_like(ends)
+    best = np.full(len(ends), np.inf)
+    after = np.full(len(ends), np.inf)
+    for _, pts, disp in moved:
+        d, nn = cKDTree(pts).query(ends, distance_upper_bound=tol)
+        take = d < best
+        best[take] = d[take]
+        shift[take] = disp[nn[take]]
+        after = np.minimum(after, cKDTree(pts + disp).query(ends)[0])
+    lost = np.flatnonzero(np.isfinite(best) & (after > tol))
+    if not lost.size:
+        return
+    Q, sid = samples[0], samples[1]
+    free = ~np.isin(sid, list(done))
+    tree = cKDTree(Q[free])
+    fsid = sid[free]
+    for q in lost.tolist():
+        j, at_end = others[q // 2], q % 2 == 1
+        if (np.any(fsid[tree.query_ball_point(ends[q], tol)] != j)
+                or np.linalg.norm(ends[q] - ends[q ^ 1]) <= tol):
+            continue  # in touch with another stroke or its own other end: it stays
+        poly, cum = st.polys[j], st.cums[j]
+        x = (cum[-1] - cum) if at_end else cum
+        R = max(min(blend * tol, 0.45 * cum[-1]), DIVISION_GUARD)  # guard: zero-length stroke
+        st.set(j, poly + bump(x / R)[:, None] * shift[q])
 
 
 def _close_loop(poly, cum, tol):

@@ -99,6 +99,19 @@ def test_ring_short_of_its_start_between_two_crossings_closes():
     assert len(ring_edges) == 2
 
 
+
+def test_stroke_touching_only_the_run_past_the_start_stays_attached():
+    """A line whose end lies 0.9 TOL inside the ring's run past its start (10% past, the
+    stretches 0.8 TOL apart) and 1.3 TOL from the averaged loop, touching nothing else:
+    its end follows the run onto the loop and is a T-junction there, not a dangling end
+    (before: the averaged loop left it out of reach; cassie 02-2-1)."""
+    d = 0.4 * TOL
+    mid = 0.3 + np.pi * 0.10
+    u = np.array([np.cos(mid), np.sin(mid), 0.0])
+    net = _snap(_past(0.10, d), _line((1 - d - 0.9 * TOL) * u, 0.3 * u))
+    assert _degrees(net) == [1, 3] and net.number_of_edges == 2
+    assert net.report["overdrawn_loops"] == 1 and net.report["t_junctions"] == 1
+
 @pytest.mark.parametrize("turns,pitch", [(2, 0.6), (3, 0.4)])
 def test_spiral_stays_as_drawn(turns, pitch):
     """A planar spiral of 2 or 3 turns whose turns lie 0.6 or 0.4 TOL apart (side by side
