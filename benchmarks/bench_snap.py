@@ -2,7 +2,8 @@
 
 Run ``python benchmarks/bench_snap.py`` (``--data ../shared/data`` prints one line
 of snapping statistics per public data file instead; ``--recovery --seeds 200 --gap
-0.04`` the graph-recovery rate per shape on the independent redraws of issue 16).
+0.04`` the graph-recovery rate per shape on the independent redraws of issue 16, with
+``--generator loop_sketch`` on rings drawn past or short of their start, issue 33).
 Prints one row per case: strokes, points, seconds (best of ``--repeat``), and
 whether the snapped graph matches the clean network it was re-drawn from
 (:func:`curvenet.datasets.redraw.match_networks`).
@@ -22,6 +23,7 @@ import numpy as np
 
 from curvenet.datasets import shapes
 from curvenet.datasets.redraw import match_networks, rough_sketch
+from curvenet.datasets.redraw_loops import loop_sketch
 from curvenet.model.sketch import Sketch
 from curvenet.snap.graph import DEFAULT_SNAP_TOL, snap
 
@@ -194,15 +196,19 @@ RECOVERY_SHAPES = ("sphere", "ellipsoid", "torus", "capped_cylinder", "box", "l_
                    "grid_box", "saddle", "two_boxes")
 
 
+#: Redraw models of the library, by name (the others are ``tests/curvenet/_NAME.py``).
+LIBRARY_GENERATORS = {"rough_sketch": rough_sketch, "loop_sketch": loop_sketch}
+
+
 def _recovery_trial(job):
     """Snap one redraw; returns (shape, seed, ok, reason)."""
-    name, seed, gap, generator = job
+    name, seed, gap, generator, snap_tol = job
     import importlib
     from tests.curvenet import _redraw2
     ref = shapes.SHAPES[name]().network
-    draw = (rough_sketch if generator == "rough_sketch" else
-            getattr(importlib.import_module(f"tests.curvenet._{generator}"), generator))
-    net = snap(draw(ref, seed=seed, gap=gap))
+    draw = LIBRARY_GENERATORS.get(generator) or getattr(
+        importlib.import_module(f"tests.curvenet._{generator}"), generator)
+    net = snap(draw(ref, seed=seed, gap=gap), snap_tol=snap_tol)
     if _redraw2.graph_recovered(ref, net):
         return name, seed, True, ""
     dv = net.number_of_vertices - ref.number_of_vertices
@@ -216,17 +222,19 @@ def _recovery_trial(job):
     return name, seed, False, f"{why}; tol {net.report['snap_tol']:.2%}"
 
 
-def recovery_table(seeds, gap, shape_names=RECOVERY_SHAPES, jobs=1, generator="redraw2"):
+def recovery_table(seeds, gap, shape_names=RECOVERY_SHAPES, jobs=1, generator="redraw2",
+                   snap_tol="auto"):
     """Graph-recovery rate per shape on rough redraws (default ``tests/curvenet/_redraw2.py``).
 
-    Each of ``seeds`` seeded redraws per shape (largest split gap ``gap`` of the diagonal)
-    is snapped with the default ``snap_tol="auto"`` and checked with
+    Each of ``seeds`` seeded redraws per shape (largest gap ``gap`` of the diagonal: split
+    gaps, and for ``loop_sketch`` a ring's stop short of its start and its drift beside
+    it) is snapped at ``snap_tol`` (default ``"auto"``) and checked with
     ``graph_recovered``. Prints one row per shape with its failing seeds and why
     (vertex, edge and per-degree count differences; the tolerance used).
     """
     import sys
     sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-    work = [(name, s, gap, generator) for name in shape_names for s in seeds]
+    work = [(name, s, gap, generator, snap_tol) for name in shape_names for s in seeds]
     if jobs > 1:
         from multiprocessing import Pool
         with Pool(jobs) as pool:
@@ -242,7 +250,7 @@ def recovery_table(seeds, gap, shape_names=RECOVERY_SHAPES, jobs=1, generator="r
         for _, seed, _, why in (r for r in rows if not r[2]):
             print(f"    seed {seed}: {why}")
     print(f"{'all':16s} {tot:4d}/{len(res)} ({tot / len(res):.1%}) at gaps <= {gap:.1%}, "
-          f"generator {generator}")
+          f"generator {generator}, snap_tol {snap_tol}")
 
 
 def main(argv=None):
@@ -262,13 +270,17 @@ def main(argv=None):
                     "fraction of the diagonal")
     ap.add_argument("--shapes", default=",".join(RECOVERY_SHAPES), help="--recovery: shapes")
     ap.add_argument("--generator", default="redraw2", help="--recovery: the generator: "
-                    "redraw2 or redraw3 (function NAME in tests/curvenet/_NAME.py), or "
-                    "rough_sketch (curvenet.datasets.redraw)")
+                    "redraw2 or redraw3 (function NAME in tests/curvenet/_NAME.py), "
+                    "rough_sketch (curvenet.datasets.redraw) or loop_sketch (rings drawn "
+                    "past or short of their start, curvenet.datasets.redraw_loops)")
+    ap.add_argument("--snap-tol", default="auto", help="--recovery: snapping tolerance, "
+                    "a fraction of the diagonal or auto (the default)")
     ap.add_argument("--jobs", type=int, default=1, help="--recovery: worker processes")
     args = ap.parse_args(argv)
     if args.recovery:
         recovery_table(range(args.first_seed, args.first_seed + args.seeds), args.gap,
-                       args.shapes.split(","), args.jobs, args.generator)
+                       args.shapes.split(","), args.jobs, args.generator,
+                       args.snap_tol if args.snap_tol == "auto" else float(args.snap_tol))
         return
     if args.big:
         big_table(args.big)

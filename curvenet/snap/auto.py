@@ -10,9 +10,12 @@ How the tolerance is chosen
 1. Every stroke is resampled every ``0.2%`` of the diagonal (coarser when that
    would exceed :data:`_MAX_POINTS` samples).
 2. **End distances.** For each stroke end, the distance to the nearest sample of
-   any other stroke (a closed stroke's end also counts its own other end). Ends
-   meant to join another stroke (a gap, an undershoot, a T) lie close to it;
-   free ends lie far from everything. Sorted, the distances show the two
+   any other stroke. Ends meant to join another stroke (a gap, an undershoot, a T)
+   lie close to it; free ends lie far from everything. A stroke whose two ends
+   each lie within a quarter of its length of the other end's stretch (its first
+   or last :data:`~curvenet.snap.strokes.LOOP_OVERLAP`: a closed stroke, or a loop
+   drawn past its start) counts those distances too: its ends join each other or
+   its own beginning. Sorted, the distances show the two
    populations as a jump: the largest ratio between consecutive distances
    below :data:`AUTO_MAX` separates them, and the tolerance is placed above the
    joins (``1.2 x`` the largest) and below the free ends (``/ 1.2``).
@@ -35,7 +38,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..core.errors import InvalidParameterError
-from .strokes import Strokes, sample
+from .strokes import Strokes, own_ends, sample
 
 __all__ = ["AUTO_MAX", "SketchTooDense", "auto_tolerance", "check_density"]
 
@@ -79,7 +82,8 @@ def auto_tolerance(strokes, diag, default):
         st.add(p, (k,), "boundary")
     total = sum(st.length(k) for k in range(len(st)))
     h = max(_STEP * diag, total / _MAX_POINTS)
-    Q, sid, _, tan, start, _ = sample(st, h)
+    samples = sample(st, h)
+    Q, sid, _, tan, start, _ = samples
     tree = cKDTree(Q)
     reach = 0.1 * diag
     k = min(_K, len(Q))
@@ -89,12 +93,12 @@ def auto_tolerance(strokes, diag, default):
     dist, nn = dist.reshape(len(ends), k), nn.reshape(len(ends), k)
     other = np.isfinite(dist) & (sid[np.minimum(nn, len(Q) - 1)] != sid[ends][:, None])
     d_end = np.where(other, dist, np.inf).min(axis=1)
-    n = len(strokes)
-    own = np.linalg.norm(Q[start[:-1]] - Q[start[1:] - 1], axis=1)
-    lengths = np.array([st.length(q) for q in range(n)])
-    closed = lengths > 4.0 * own
-    d_end = np.minimum(d_end, np.where(np.concatenate([closed, closed]),
-                                       np.concatenate([own, own]), np.inf)) / diag
+    # a closed stroke's end joins its own other end, the end of a loop drawn past its
+    # start its own beginning (or, both, another stroke they end near)
+    _, d_last, _, d_first = own_ends(samples)
+    lengths = np.array([st.length(q) for q in range(len(strokes))])
+    loop = np.tile(lengths > 4.0 * np.maximum(d_last, d_first), 2)
+    d_end = np.minimum(d_end, np.where(loop, np.concatenate([d_first, d_last]), np.inf)) / diag
     # 3. parallel spacing
     step = max(int(round(_PAR_STEP * diag / h)), len(Q) // _MAX_PROBES, 1)
     probe = np.arange(0, len(Q), step)

@@ -16,14 +16,28 @@ Pipeline of :func:`snap` (``mode="rough"``)
    all sample pairs of different strokes within ``tol`` with one KD-tree
    (``scipy.spatial.cKDTree.query_pairs``). Pairs are grouped per stroke pair
    into *contacts* (runs along the first stroke).
-3. Overdraw: a contact longer than ``overdraw_length * tol`` on both strokes,
+3. Loops drawn past their start (issue 33): a stroke whose end runs back along its
+   own beginning (its last point within ``tol`` of its first 15%, its first
+   point within ``tol`` of its last 15%, the two stretches side by side within
+   ``tol`` all along and running the same way within ``overdraw_angle``, the lap
+   between enclosing an area, see :func:`curvenet.snap.overdraw.close_loops`)
+   becomes one closed loop, the two stretches averaged and the lap's ends bent onto
+   the average with the C1 bumps of step 6. Checked again after each overdraw
+   round (a ring drawn in two pieces, the second run past the first's start, is
+   one stroke by then). A stroke that spirals (its ends farther than ``tol`` from
+   the other end's stretch) or folds back over itself stays as drawn. An end of
+   another stroke that touched only the stretches, and that the average leaves out
+   of reach, moves with them (C1 bump).
+   Overdraw: a contact longer than ``overdraw_length * tol`` on both strokes,
    with tangents within ``overdraw_angle``, is one curve drawn twice. The
    stroke more covered by it (the guest) loses the overlapping stretch; the
    host moves halfway onto the guest there (an average, tapered at both ends),
    so no sliver cycle remains. Repeated until no overdraw is left. A contact
    that touches both ends of a nearly closed stroke (a short stroke drawn over
-   its opening) is split where it jumps between them; a host that a guest
-   piece extends past its own start is closed there.
+   its opening) is split where it jumps between them; a host that a guest piece
+   extends past its own start, its end within ``tol`` of the start in its last
+   ``3 tol``, is cut back there (a run past the start too short for the loop rule
+   above, under a sample spacing, is otherwise left overlapping its start).
 4. Every other contact is a junction candidate at its closest sample pair:
    the midpoint for a crossing or two ends (gap), the point on the other stroke
    for an end touching a stroke interior (T-junction). A stroke whose two ends
@@ -32,7 +46,10 @@ Pipeline of :func:`snap` (``mode="rough"``)
    junctions within ``1.5 tol`` along one stroke, closest first; a gap (two
    stroke ends) that has joined a junction does not pull in a second one, nor
    do two junctions that strokes pass through merge along a short stroke that
-   runs from one to the other.
+   runs from one to the other; nor does a closed stroke's seam (its two ends
+   meeting) that has joined a junction the stroke passes through pull in a
+   second one along the stroke (a ring stopping short between two crossings
+   would chain them).
 5. Corners: where a stroke turns by more than ``corner_angle`` between the
    chords ``tol * corner_window`` before and after a point (local maximum),
    and no junction is within ``tol``, it gets a degree-2 vertex.
@@ -65,7 +82,17 @@ unit-box inputs give the same network up to scale. Deterministic: no random
 numbers; ties are broken by stroke and sample order.
 
 Not handled (documented gaps): a stroke crossing itself in its interior stays
-one piece there; an end touching its own stroke's interior is not snapped.
+one piece there; an end touching its own stroke's interior is not snapped, unless
+it is a loop drawn past its start (step 3); a stroke drawn round two or more times
+(an overlap over 15% of its length) stays as drawn.
+
+Departure from Abbasinejad et al. (Sec. 6.1): the paper snaps pairs of curves
+("two curves intersect when they pass within a user-defined threshold") and
+fixed by hand in Maya what that missed; ILoveSketch strokes rarely overlap
+themselves. VR designers draw a ring in one stroke and carry on past its start
+(issue 33): a pair rule never sees a stroke against itself, and the run past the
+start stays a dangling curve or doubles the patches beside it. Step 3 extends the
+overdraw merge to a stroke over its own beginning.
 """
 
 from __future__ import annotations
@@ -112,9 +139,9 @@ _CROSSING_CHUNK = 20_000
 DEFAULT_SNAP_TOL = 0.025
 
 #: Counters present in every ``network.report`` (see :func:`snap`).
-_COUNTERS = ("crossings", "t_junctions", "gap_merges", "closed_strokes", "trimmed_overshoots",
-             "overdraw_consolidations", "corners", "dissolved_joins", "slivers_merged",
-             "strokes_dropped_short", "strokes_trimmed_away")
+_COUNTERS = ("crossings", "t_junctions", "gap_merges", "closed_strokes", "overdrawn_loops",
+             "trimmed_overshoots", "overdraw_consolidations", "corners", "dissolved_joins",
+             "slivers_merged", "strokes_dropped_short", "strokes_trimmed_away")
 
 
 @dataclass(frozen=True)
@@ -311,7 +338,9 @@ def snap(sketch: Sketch, *, snap_tol: float | str | None = "auto", corner_angle:
         and list their source stroke ids (indices into ``sketch.strokes``).
         ``report`` (dict): ``mode``, ``tol`` (absolute), ``diagonal``,
         ``junctions`` (vertices of degree >= 3), ``t_junctions``,
-        ``crossings``, ``gap_merges``, ``closed_strokes``, ``trimmed_overshoots``,
+        ``crossings``, ``gap_merges``, ``closed_strokes``, ``overdrawn_loops``
+        (strokes whose end ran back along their own beginning, merged into one
+        loop), ``trimmed_overshoots``,
         ``overdraw_consolidations``, ``corners``, ``dissolved_joins``,
         ``slivers_merged``, ``dangling_ends`` (count) and ``dangling_vertices``
         (ids), ``strokes_used``, ``strokes_dropped_short`` (fewer than two
@@ -402,7 +431,13 @@ def _snap_auto(strokes, src, labels, diag, opts):
     worse and better in one respect: no fewer independent cycles (the cycle
     rank, an upper bound on the patches) and no more dangling ends. A larger
     tolerance that merges small features loses cycles and is refused; a smaller
-    one that leaves gaps open adds dangling ends and is refused.
+    one that leaves gaps open adds dangling ends and is refused. At equal cycles it
+    is taken when it has fewer dangling ends because it merges more loops drawn
+    past their start (``report["overdrawn_loops"]``): a ring whose run past its
+    start lies beyond the default closes through a stroke crossing both stretches,
+    with the same cycles, and leaves the run as a dangling curve (issue 33). Fewer
+    dangling ends alone at equal cycles is not enough: on the public sketches it
+    cost patches (cassie 06-1-1, 22 -> 21).
 
     Returns (network, options with the tolerance used, reason).
     """
@@ -421,10 +456,10 @@ def _snap_auto(strokes, src, labels, diag, opts):
 
     def score(net):
         deg = np.bincount(net.endpoints.ravel(), minlength=net.number_of_vertices)
-        return net.cycle_rank(), int((deg == 1).sum())
+        return net.cycle_rank(), int((deg == 1).sum()), net.report["overdrawn_loops"]
 
-    (r_c, d_c), (r_0, d_0) = score(net_c), score(net_0)
-    if r_c > r_0 and d_c <= d_0:
+    (r_c, d_c, o_c), (r_0, d_0, o_0) = score(net_c), score(net_0)
+    if d_c <= d_0 and (r_c > r_0 or (r_c == r_0 and d_c < d_0 and o_c > o_0)):
         return net_c, cand, (f"auto: {why}; against the default {DEFAULT_SNAP_TOL:.1%}: "
                              f"cycles {r_0} -> {r_c}, dangling ends {d_0} -> {d_c}")
     return net_0, base, (f"auto: default; {tol:.2%} was measured ({why}) but gives cycles "
@@ -457,7 +492,8 @@ def summary_line(report: dict) -> str:
         tol = f"tolerance {r['snap_tol']:.2%} of the diagonal ({r['snap_tol_reason']})"
     merges = (f"{r.get('gap_merges', 0)} gaps closed, {r.get('t_junctions', 0)} T-junctions, "
               f"{r.get('crossings', 0)} crossings, {r.get('overdraw_consolidations', 0)} "
-              f"overdraws merged, {r.get('trimmed_overshoots', 0)} overshoots trimmed")
+              f"overdraws merged, {r.get('overdrawn_loops', 0)} loops drawn past their start "
+              f"closed, {r.get('trimmed_overshoots', 0)} overshoots trimmed")
     return (f"snap: {tol}; {r['vertices']} vertices, {r['edges']} curves, "
             f"{r['junctions']} junctions; {merges}; {r['dangling_ends']} dangling ends")
 

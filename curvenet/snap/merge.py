@@ -24,15 +24,20 @@ def join_near(near, cid, gap, ends, held, L, tol):
     2 neither or both)``. A split stroke (two stroke ends meeting in a gap, nothing else)
     does not pull in a junction one piece passes through once the gap has joined a
     junction some stroke passes through: a gap between two nearby crossings would chain
-    them into one. ``held`` (first candidate of a junction -> such pieces) carries over
-    rounds and is updated in place. Nor do two junctions that strokes pass through merge
+    them into one. Likewise the seam of a closed stroke (its own two ends, nothing else):
+    once joined to such a junction, the stroke pulls in no other junction it passes
+    through there (a ring that stops short between two crossings would chain them).
+    ``held`` (first candidate of a junction -> such strokes) carries over rounds and is
+    updated in place. Nor do two junctions that strokes pass through merge
     along a short stroke that runs from one to the other (its start at one, its end at
     the other): a piece between two gaps, each next to a crossing, would chain the two.
     """
     (ds, kk, j1, j2), (ej, ek, only, end) = near, ends
     key = ej * len(L) + ek
-    split = (np.bincount(ej, minlength=cid.max() + 1) == 2) & (
-        np.bincount(ej, weights=~only, minlength=cid.max() + 1) == 0)
+    per = np.bincount(ej, minlength=cid.max() + 1)
+    gaps = np.bincount(ej, weights=~only, minlength=cid.max() + 1) == 0
+    split = (per == 2) & gaps
+    seam = (per == 1) & gaps  # a closed stroke's own two ends (candidates of one stroke)
     through = np.bincount(cid, weights=~gap) > 0  # some stroke passes through
     fi = first_items(cid)
     parent, out = {}, []
@@ -61,6 +66,8 @@ def join_near(near, cid, gap, ends, held, L, tol):
             if split[jx] and through[ry]:  # (a stroke under 2 tol is all ends)
                 lo = np.searchsorted(ej, jx)
                 new |= {int(y) for y in ek[lo:lo + 2] if y != k and L[y] > 2.0 * tol}
+            elif seam[jx] and through[ry]:  # a closed stroke's own ends: the stroke itself
+                new.add(k)
         root = min(ra, rb)
         parent[max(ra, rb)] = root
         through[root] = through[ra] or through[rb]

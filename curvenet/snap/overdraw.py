@@ -1,7 +1,9 @@
 """Overdraw consolidation of the tolerance-based snapping (steps 3 and 7 of :mod:`curvenet.snap`).
 
 Private module, split from :mod:`curvenet.snap.rough` by topic: a stroke drawn
-over (part of) another one is cut out of the guest and averaged into the host;
+over (part of) another one is cut out of the guest and averaged into the host; a
+stroke whose end runs back along its own beginning (a ring drawn past its start)
+becomes one closed loop, the two stretches averaged (:func:`close_loops`);
 parallel edges left between the same two vertices (slivers) are averaged.
 All lengths are absolute (``tol = snap_tol * diagonal``).
 """
@@ -11,11 +13,17 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .strokes import Strokes, clean, smoothstep
+from .strokes import Strokes, bump, clean, own_ends, smoothstep
 from ..core.geometry import cumulative_length, interpolate_polyline, resample_polyline
 from ..core.tolerances import DIVISION_GUARD
 
-__all__ = ["consolidate", "merge_slivers"]
+__all__ = ["consolidate", "close_loops", "merge_slivers"]
+
+#: Least area a lap drawn past its start encloses, per unit of its length, times ``tol``
+#: (the magnitude of its vector area, so any loop's largest projected area): a circle of
+#: radius ``tol`` has ``0.5``. A stroke folded over itself (a thin scribble, two short
+#: strokes consolidated into a Z) encloses next to none.
+_LOOP_AREA = 0.5
 
 
 def consolidate(st, samples, con, tol, h, opts, report):
@@ -122,6 +130,142 @@ def consolidate(st, samples, con, tol, h, opts, report):
     return out
 
 
+def close_loops(st, samples, tol, h, opts, report):
+    """Merge every stroke whose end runs back along its own beginning into one closed loop.
+
+    Parameters
+    ----------
+    st : Strokes
+        Edited in place (:meth:`Strokes.set`) for each stroke merged.
+    samples : tuple
+        :func:`curvenet.snap.strokes.sample` of ``st`` at spacing ``h``.
+    tol, h : float
+        Absolute snapping tolerance and sample spacing.
+    opts : SnapOptions
+        ``overdraw_angle`` bounds the angle between the two stretches; ``blend`` the
+        reach of the join.
+    report : dict
+        ``report["overdrawn_loops"]`` is increased by the number merged.
+
+    Returns
+    -------
+    int
+        Strokes merged.
+
+    Notes
+    -----
+    A stroke of length ``L`` is a loop drawn past its start when, with ``a``, ``b``
+    from :func:`curvenet.snap.strokes.own_ends` (the windows are the first and last
+    :data:`~curvenet.snap.strokes.LOOP_OVERLAP` of ``L``):
+
+    * its last point lies within ``tol`` of its first stretch, at ``a`` past the
+      start, and its first point within ``tol`` of its last stretch, at ``b``;
+    * the overlap is more than one sample spacing on both sides (``a > h``,
+      ``L - b > h``; less is a closed stroke, left to the closing of ends within
+      ``tol``) and the lap ``b`` is longer than ``4 tol`` (as a closed stroke);
+    * the stretches ``[0, a]`` and ``[b, L]`` are side by side: every sample of
+      each lies within ``tol`` of the other (a spiral drifts apart, a hook turns
+      away), and they run the same way, the mean cosine of the tangents of nearest
+      samples at least ``cos(overdraw_angle)`` (a stroke doubling back is no loop);
+    * the lap ``[0, b]`` goes round something: its vector area is at least
+      :data:`_LOOP_AREA` ``tol b`` (a thin scribble, or a stroke folded over itself
+      in a Z, three strands side by side, encloses next to none).
+
+    The loop is the average of the two stretches (each point of ``[0, a]`` moved
+    halfway to its closest point on ``[b, L]``), closed through the stroke from ``a``
+    to ``b``, whose two ends are moved onto the average's ends by the C1 bumps of
+    the junction step, ``(1 - x^2)^2`` over ``R = min(blend tol, 0.45 (b - a))``
+    (a step across the overlap's ends would kink where the two stretches lie far
+    apart over a short overlap). Its first and last points are the same, so it
+    snaps as a closed stroke. Checking the candidates loops over strokes (the few
+    whose ends pass the first test), each with vectorised KD-tree queries.
+
+    References
+    ----------
+    Abbasinejad, Joshi, Amenta, "Surface patches from unorganized space curves",
+    SGP 2011, Sec. 6.1: curves are snapped in pairs ("two curves intersect when
+    they pass within a user-defined threshold"), and what that missed was fixed by
+    hand; a stroke drawn over its own beginning is not among its cases. This
+    extends the overdraw merge from a second stroke over a first one to a stroke
+    over itself (issue 33).
+    """
+    Q, _, ss, tan, start, flat = samples
+    a, d_last, b, d_first = own_ends(samples)
+    cand = np.flatnonzero((d_last <= tol) & (d_first <= tol) & (a > h) & (flat.L - b > h)
+                          & (b > 4.0 * tol))
+    cos_od = np.cos(np.radians(opts.overdraw_angle))
+    merged = 0
+    moved = []
+    for k in cand.tolist():
+        run = slice(start[k], start[k + 1])
+        head, tail = ss[run] <= a[k], ss[run] >= b[k]
+        qh, qt = Q[run][head], Q[run][tail]
+        dh, nn = cKDTree(qt).query(qh)
+        dt, _ = cKDTree(qh).query(qt)
+        if max(dh.max(), dt.max()) > tol or np.einsum(
+                "ij,ij->i", tan[run][head], tan[run][tail][nn]).mean() < cos_od:
+            continue
+        lap = Q[run][ss[run] <= b[k]] - Q[run][0]
+        area = 0.5 * np.linalg.norm(np.cross(lap[:-1], lap[1:]).sum(axis=0))  # vector area
+        if area < _LOOP_AREA * tol * b[k]:
+            continue  # a stroke folded over itself, a thin scribble
+        st.set(k, _merge_own(st.polys[k], st.cums[k], a[k], b[k], qt, tol, opts.blend))
+        moved.append((k, np.vstack([qh, qt]),
+                      0.5 * np.vstack([_project(qh, qt) - qh, _project(qt, qh) - qt])))
+        merged += 1
+    if moved:
+        _follow(st, samples, moved, tol, opts.blend)
+    report["overdrawn_loops"] += merged
+    return merged
+
+
+def _follow(st, samples, moved, tol, blend):
+    """Move the ends of other strokes that touch a merged loop's stretches along with them.
+
+    ``samples``: those of :func:`close_loops` (before the merge); ``moved``: per loop,
+    its stroke id, the samples ``(n, 3)`` of its two stretches before the merge and
+    their displacements ``(n, 3)`` onto the average. An end of another stroke (not
+    itself merged) within ``tol`` of those samples, which the average leaves farther
+    than ``tol`` from the loop and which touches no other stroke nor its own other end
+    (an end still in touch, closing a gap or a ring's seam, or at a crossing, stays), is
+    moved by the displacement of the nearest sample, tapered along its stroke by the C1
+    bump of the junction step over ``R = min(blend tol, 0.45 L)``: a stroke that
+    touched only the run past the start stays in touch with the loop (cassie 02-2-1: a
+    stroke starting 0.95 tol from a ring's run past its start was 1.1 tol from the
+    average, and dangled).
+    """
+    done = {k for k, _, _ in moved}
+    others = [j for j in range(len(st)) if j not in done]
+    if not others:
+        return
+    ends = np.array([[st.polys[j][0], st.polys[j][-1]] for j in others]).reshape(-1, 3)
+    shift = np.zeros_like(ends)
+    best = np.full(len(ends), np.inf)
+    after = np.full(len(ends), np.inf)
+    for _, pts, disp in moved:
+        d, nn = cKDTree(pts).query(ends, distance_upper_bound=tol)
+        take = d < best
+        best[take] = d[take]
+        shift[take] = disp[nn[take]]
+        after = np.minimum(after, cKDTree(pts + disp).query(ends)[0])
+    lost = np.flatnonzero(np.isfinite(best) & (after > tol))
+    if not lost.size:
+        return
+    Q, sid = samples[0], samples[1]
+    free = ~np.isin(sid, list(done))
+    tree = cKDTree(Q[free])
+    fsid = sid[free]
+    for q in lost.tolist():
+        j, at_end = others[q // 2], q % 2 == 1
+        if (np.any(fsid[tree.query_ball_point(ends[q], tol)] != j)
+                or np.linalg.norm(ends[q] - ends[q ^ 1]) <= tol):
+            continue  # in touch with another stroke or its own other end: it stays
+        poly, cum = st.polys[j], st.cums[j]
+        x = (cum[-1] - cum) if at_end else cum
+        R = max(min(blend * tol, 0.45 * cum[-1]), DIVISION_GUARD)  # guard: zero-length stroke
+        st.set(j, poly + bump(x / R)[:, None] * shift[q])
+
+
 def _close_loop(poly, cum, tol):
     """Cut back an end that runs on past the stroke's own start; None if not a loop.
 
@@ -143,6 +287,39 @@ def _close_loop(poly, cum, tol):
     if head @ back <= 0.5 * np.linalg.norm(head) * np.linalg.norm(back):
         return None
     return poly[:q + 1]
+
+
+def _merge_own(poly, cum, a, b, tail, tol, blend):
+    """Closed loop ``(m, 3)`` of a stroke whose stretch ``[b, L]`` runs along ``[0, a]``.
+
+    ``tail``: samples ``(t, 3)`` of ``[b, L]``, the first at ``b``. See :func:`close_loops`.
+    """
+    head = _cut(poly, cum, 0.0, a)
+    avg = head + 0.5 * (_project(head, tail) - head)
+    middle = _cut(poly, cum, a, b)
+    s = cumulative_length(middle)
+    R = max(min(blend * tol, 0.45 * s[-1]), DIVISION_GUARD)  # guard: b - a >= L / 2 > 2 tol
+    middle = (middle + bump(s / R)[:, None] * (avg[-1] - middle[0])
+              + bump((s[-1] - s) / R)[:, None] * (avg[0] - middle[-1]))
+    loop = np.vstack([middle, avg[1:]])
+    loop[-1] = loop[0]
+    return clean(loop, 0.05 * tol)
+
+
+def _project(points, line):
+    """Closest points ``(n, 3)`` of polyline ``line (t, 3)``, ``t >= 2``, to ``points (n, 3)``:
+    on the two segments beside the nearest vertex of ``line``."""
+    _, nn = cKDTree(line).query(points)
+    best, best_d = line[nn], np.linalg.norm(line[nn] - points, axis=1)
+    for j in (np.maximum(nn - 1, 0), np.minimum(nn, len(line) - 2)):  # segments j -> j + 1
+        d = line[j + 1] - line[j]
+        t = np.clip(np.einsum("ij,ij->i", points - line[j], d)
+                    / np.maximum(np.einsum("ij,ij->i", d, d), DIVISION_GUARD), 0.0, 1.0)
+        q = line[j] + t[:, None] * d
+        dq = np.linalg.norm(q - points, axis=1)
+        better = dq < best_d
+        best[better], best_d[better] = q[better], dq[better]
+    return best
 
 
 def _cut(poly, cum, a, b):

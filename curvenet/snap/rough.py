@@ -13,7 +13,7 @@ from scipy.spatial import cKDTree
 from .auto import check_density
 from .joins import chord_turn, dissolve
 from .merge import components, join_near
-from .overdraw import consolidate, merge_slivers
+from .overdraw import close_loops, consolidate, merge_slivers
 from .strokes import Strokes, bump, clean, sample
 from ..core.geometry import arc_length, interpolate_polyline, segment_closest
 from ..core.tolerances import DIVISION_GUARD
@@ -136,26 +136,31 @@ def _group_pairs(pairs, samples, tol, h, st, opts):
 
 
 def _overdraw_rounds(st, tol, h, opts, report):
-    """Consolidate overdraw (up to 12 rounds) before junctions are sought.
+    """Close loops drawn past their start and consolidate overdraw (up to 12 rounds) before
+    junctions are sought.
 
+    Each round first merges the strokes whose end runs back along their own beginning
+    (:func:`curvenet.snap.overdraw.close_loops`: the input's, and those a consolidation
+    has just extended past their start), then consolidates the overdraw between strokes.
     Returns the strokes, their samples and their contacts (none an overlap).
     """
-    since = None
-    for _round in range(12):
+    prev = None
+    for _round in range(13):
         samples = sample(st, h)
         if _round == 0:
             check_density(samples, tol, opts.snap_tol)
+        if close_loops(st, samples, tol, h, opts, report):
+            samples = sample(st, h)
+        since = None if prev is None else (prev[0], prev[1], _unchanged(prev[2], st.polys))
         con = _contacts(samples, tol, h, st, opts, since)
         if not con["overlap"].any():
             return st, samples, con
-        polys = list(st.polys)  # consolidate edits st: keep the polylines before it
+        if _round == 12:
+            break
+        prev = (con, samples[4], list(st.polys))  # consolidate edits st: keep the polylines
         st = consolidate(st, samples, con, tol, h, opts, report)
-        since = (con, samples[4], _unchanged(polys, st.polys))
-    samples = sample(st, h)
-    con = _contacts(samples, tol, h, st, opts, since)
-    if con["overlap"].any():
-        report["warnings"].append("overdraw left after 12 rounds; treated as crossings")
-        con["overlap"][:] = False
+    report["warnings"].append("overdraw left after 12 rounds; treated as crossings")
+    con["overlap"][:] = False
     return st, samples, con
 
 
@@ -387,9 +392,9 @@ def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
     """Tolerance-based snapping; see :mod:`curvenet.snap` for the steps."""
     tol = opts.snap_tol * diag
     report = {"mode": "rough", "crossings": 0, "t_junctions": 0, "gap_merges": 0,
-              "closed_strokes": 0, "trimmed_overshoots": 0, "overdraw_consolidations": 0,
-              "corners": 0, "dissolved_joins": 0, "slivers_merged": 0,
-              "strokes_dropped_short": 0, "warnings": []}
+              "closed_strokes": 0, "overdrawn_loops": 0, "trimmed_overshoots": 0,
+              "overdraw_consolidations": 0, "corners": 0, "dissolved_joins": 0,
+              "slivers_merged": 0, "strokes_dropped_short": 0, "warnings": []}
     st = Strokes()
     for p, s, lab in zip(strokes, src, labels):
         if arc_length(p) < opts.min_length * tol:

@@ -12,7 +12,15 @@ import numpy as np
 from ..core.geometry import cumulative_length
 from ..core.tolerances import DIVISION_GUARD
 
-__all__ = ["dedup", "clean", "bump", "smoothstep", "Strokes", "Flat", "sample"]
+__all__ = ["dedup", "clean", "bump", "smoothstep", "Strokes", "Flat", "sample", "LOOP_OVERLAP",
+           "own_ends"]
+
+#: Longest stretch, as a fraction of a stroke's length, that its end may run back along its
+#: own beginning and still be one loop drawn past its start (issue 33: designers run on by up
+#: to a tenth of the ring, 9% of the stroke; this leaves half as much again and stays far
+#: below the half of a second turn. A quarter also took a hook consolidated with a line for
+#: a loop in the public sketch cassie 05-0-2, which lost a patch).
+LOOP_OVERLAP = 0.15
 
 
 # --------------------------------------------------------------------------- small tools
@@ -107,6 +115,45 @@ class Flat:
         seg = self.G[j + 1] - self.G[j]
         t = np.clip((g - self.G[j]) / np.maximum(seg, DIVISION_GUARD), 0.0, 1.0)  # guard 0-length
         return self.P[j] + t[:, None] * (self.P[j + 1] - self.P[j])
+
+
+def own_ends(samples, frac=LOOP_OVERLAP):
+    """Where each stroke's ends come closest to its own other end's stretch.
+
+    Parameters
+    ----------
+    samples : tuple
+        The output of :func:`sample`.
+    frac : float
+        Length of the stretch searched at each end, a fraction of the stroke's length.
+
+    Returns
+    -------
+    a, d_last, b, d_first : (S,) float64 each
+        ``a``: arc parameter of the sample of the first ``frac`` of the stroke closest
+        to its last point, at distance ``d_last``; ``b``: that of the sample of the last
+        ``frac`` closest to its first point, at distance ``d_first``. A stroke whose end
+        runs back along its own beginning has both distances small, ``a > 0`` and
+        ``b < L``; a closed stroke (ends meeting) has ``a = 0`` and ``b = L``.
+
+    Notes
+    -----
+    One pass over all samples (no loop over strokes): each sample's distance to its
+    stroke's last and first points, masked to the two stretches (each holds the
+    stroke's first or last sample), its minimum per stroke (``minimum.reduceat``) and
+    the first sample that attains it.
+    """
+    Q, sid, ss, _, start, flat = samples
+    first, last = start[:-1], start[1:] - 1
+    L = flat.L[sid]
+    out = []
+    for mask, end in ((ss <= frac * L, last), (ss >= (1.0 - frac) * L, first)):
+        d = np.where(mask, np.linalg.norm(Q - Q[end[sid]], axis=1), np.inf)
+        low = np.minimum.reduceat(d, first)
+        hit = np.flatnonzero(d == low[sid])
+        best = hit[np.unique(sid[hit], return_index=True)[1]]
+        out += [ss[best], low]
+    return tuple(out)
 
 
 def sample(st, h):
