@@ -18,7 +18,7 @@ it inside the functions.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -186,6 +186,23 @@ def _wire(loop, edges):
     return w
 
 
+#: Kinds whose first surface parameter is an angle.
+_PERIODIC = ("cylinder", "cone", "sphere", "torus")
+
+
+def _trimmed(surface, wires, tolerance: float):
+    """The surface bounded by ``wires`` (outer first), curves on it by ``ShapeFix_Face``."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
+    from OCP.ShapeFix import ShapeFix_Face
+    mk = BRepBuilderAPI_MakeFace(_geom_surface(surface), wires[0], True)
+    for w in wires[1:]:
+        mk.Add(w)
+    fx = ShapeFix_Face(mk.Face())
+    fx.SetPrecision(tolerance)
+    fx.Perform()
+    return fx.Face()
+
+
 def analytic_face(surface, boundary, edges, *, tolerance: float, name: str):
     """The elementary surface trimmed by the boundary's wires.
 
@@ -210,17 +227,17 @@ def analytic_face(surface, boundary, edges, *, tolerance: float, name: str):
     CadInputError
         A loop crosses itself on the surface.
     """
-    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
+    from OCP.BRepTools import BRepTools
     from OCP.ShapeAnalysis import ShapeAnalysis_Wire
-    from OCP.ShapeFix import ShapeFix_Face
     wires = [_wire(lp, edges) for lp in boundary]
-    mk = BRepBuilderAPI_MakeFace(_geom_surface(surface), wires[0], True)
-    for w in wires[1:]:
-        mk.Add(w)
-    fx = ShapeFix_Face(mk.Face())
-    fx.SetPrecision(tolerance)
-    fx.Perform()
-    face = fx.Face()
+    face = _trimmed(surface, wires, tolerance)
+    if surface.kind in _PERIODIC:
+        # turn the frame so the face starts at angle 0: its parameter range is then
+        # within the surface's first period, as NURBS conversion (3DM) needs
+        u0 = BRepTools.UVBounds_s(face)[0]
+        if abs(u0) > 1e-12:
+            x = np.cos(u0) * surface.xdir + np.sin(u0) * surface.ydir
+            face = _trimmed(replace(surface, xdir=x / np.linalg.norm(x)), wires, tolerance)
     for k, w in enumerate(wires):
         sa = ShapeAnalysis_Wire(w, face, tolerance)
         if sa.CheckSelfIntersection():
