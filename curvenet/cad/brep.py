@@ -109,8 +109,13 @@ def _spline_edge(c, v0, v1, tol):
     arr = Array1_gp_Pnt(1, len(c))
     for i, p in enumerate(c, 1):
         arr.SetValue(i, _pnt(p))
-    fit = GeomAPI_PointsToBSpline(arr, 3, 8, GeomAbs_C2, float(tol))
-    return BRepBuilderAPI_MakeEdge(fit.Curve(), v0, v1).Edge()
+    bs = GeomAPI_PointsToBSpline(arr, 3, 8, GeomAbs_C2, float(tol)).Curve()
+    bs.SetPole(1, _pnt(c[0]))             # clamped: the end poles are the ends, made exact
+    bs.SetPole(bs.NbPoles(), _pnt(c[-1]))
+    mk = BRepBuilderAPI_MakeEdge(bs, v0, v1, bs.FirstParameter(), bs.LastParameter())
+    if not mk.IsDone():
+        raise CadInputError(f"no edge along its {len(c)} samples ({mk.Error().name})")
+    return mk.Edge()
 
 
 def curve_edges(curves, ends, positions, used, *, diagonal: float) -> dict:
@@ -153,7 +158,10 @@ def curve_edges(curves, ends, positions, used, *, diagonal: float) -> dict:
         if arc is not None:
             out[i] = (arc, "circle")
             continue
-        out[i] = (_spline_edge(c, verts[u], verts[v], EDGE_TOL * diagonal), "bspline")
+        try:
+            out[i] = (_spline_edge(c, verts[u], verts[v], EDGE_TOL * diagonal), "bspline")
+        except CadInputError as err:
+            raise CadInputError(f"curve {i}: {err}") from None
     return out
 
 
@@ -244,6 +252,59 @@ def analytic_face(surface, boundary, edges, *, tolerance: float, name: str):
             where = "outer loop" if k == 0 else f"hole {k}"
             raise CadInputError(f"{name}: its {where} crosses itself on its {surface.kind}")
     return face
+
+
+def _loop_points(loop, curves) -> np.ndarray:
+    """The samples of a loop of ``(curve id, forward)`` in walking order: (n, 3) float64."""
+    parts = [np.asarray(curves[e], np.float64)[:: 1 if fwd else -1][:-1] for e, fwd in loop]
+    return np.concatenate(parts)
+
+
+def _crossings(xy) -> np.ndarray:
+    """Pairs ``(i, j)`` of non-neighbouring segments of the closed polygon ``xy (n, 2)``
+    that cross or touch: (k, 2) int64."""
+    n = len(xy)
+    a, b = xy, np.roll(xy, -1, axis=0)
+
+    def orient(p, q, r):        # (n, n) signs of the turn p -> q -> r
+        return np.sign((q[..., 0] - p[..., 0]) * (r[..., 1] - p[..., 1])
+                       - (q[..., 1] - p[..., 1]) * (r[..., 0] - p[..., 0]))
+    def on(p, q, r, o):         # r on segment p-q, given the turn o of p -> q -> r
+        lo, hi = np.minimum(p, q), np.maximum(p, q)
+        return (o == 0) & ((lo <= r) & (r <= hi)).all(axis=-1)
+    C, D = a[None], b[None]
+    out = []
+    for s in range(0, n, _CROSS_BLOCK):         # (block, n) tests at a time
+        A, B = a[s:s + _CROSS_BLOCK, None], b[s:s + _CROSS_BLOCK, None]
+        o1, o2, o3, o4 = orient(A, B, C), orient(A, B, D), orient(C, D, A), orient(C, D, B)
+        hit = ((o1 * o2 < 0) & (o3 * o4 < 0)) | on(A, B, C, o1) | on(A, B, D, o2) \
+            | on(C, D, A, o3) | on(C, D, B, o4)
+        i, j = np.nonzero(hit)
+        i = i + s
+        keep = (j >= i + 2) & ~((i == 0) & (j == n - 1))   # neighbours share an end
+        out.append(np.c_[i[keep], j[keep]])
+    return np.concatenate(out) if out else np.zeros((0, 2), np.int64)
+
+
+#: Rows of segment pairs tested at once by :func:`_crossings`.
+_CROSS_BLOCK = 256
+
+
+def _check_plane_loops(surface, boundary, curves, name: str) -> None:
+    """Raise :class:`CadInputError` when a planar face's loop crosses itself or another
+    of its loops (in the plane's frame)."""
+    loops = [_loop_points(lp, curves) for lp in boundary]
+    frame = np.stack([surface.xdir, surface.ydir], axis=1)
+    for k, p in enumerate(loops):
+        if len(p) >= 4 and len(_crossings((p - surface.origin) @ frame)):
+            where = "outer loop" if k == 0 else f"hole {k}"
+            raise CadInputError(f"{name}: its {where} crosses itself")
+    if len(loops) > 1:
+        from matplotlib.path import Path
+        outer = Path((loops[0] - surface.origin) @ frame)
+        for k, p in enumerate(loops[1:], 1):
+            if not outer.contains_points((p - surface.origin) @ frame).all():
+                raise CadInputError(f"{name}: its hole {k} crosses its outer loop")
 
 
 def face_kinds(shape) -> list:
@@ -427,6 +488,8 @@ def brep_shape(model: CadModel):
     faces, info, of_patch = [], [], {}
     for k in analytic:
         s = model.surfaces[k]
+        if s.kind == "plane":
+            _check_plane_loops(s, model.boundaries[k], model.curves, model.name(k))
         of_patch.setdefault(k, []).append(len(faces))
         faces.append(analytic_face(s, model.boundaries[k], edges, tolerance=tol,
                                    name=model.name(k)))
