@@ -5,7 +5,11 @@ arc (a full circle for a closed curve) or a B-spline approximating its samples
 (:func:`curve_edges`). A patch whose boundary lies on a plane, cylinder, cone, sphere
 or torus (:mod:`curvenet.surfacing.analytic`) becomes that surface trimmed by wires
 of those edges, an outer wire and one per hole, a seam edge twice in one wire
-(:func:`analytic_face`); ``ShapeFix_Face`` computes the curves on the surface. The
+(:func:`analytic_face`); ``ShapeFix_Face`` computes the curves on the surface of planes,
+cylinders, cones and seam faces, framed so the face starts at angle 0, and those of
+sphere and torus faces bounded by arcs are made from the curves' samples
+(:mod:`curvenet.cad.pcurves`). A planar loop that
+crosses itself is bad input (:class:`CadInputError`, naming the patch). The
 other patches keep their B-spline faces (the Catmull-Clark limit pieces,
 :func:`curvenet.cad.export.occ_faces`). :func:`build_solids` sews all faces per
 manifold piece (faces meeting along the curves they share), turns each closed shell
@@ -35,10 +39,9 @@ EDGE_TOL = 1e-6
 #: the curve's extent).
 LINE_TOL = 1e-7
 
-#: Analytic kinds written as trimmed elementary faces. Spheres and tori are written as
-#: their B-spline pieces: OpenCascade's curves-on-surface of arcs on them
-#: (``ShapeFix_Face``) can take the wrong period, trimming the complement of the face.
-CAD_KINDS = ("plane", "cylinder", "cone")
+#: Analytic kinds written as trimmed elementary faces (spheres and tori with their
+#: curves on the surface made from the samples, :mod:`curvenet.cad.pcurves`).
+CAD_KINDS = ("plane", "cylinder", "cone", "sphere", "torus")
 #: Sewing tolerance as a fraction of the diagonal, never below twice the largest gap
 #: between neighbouring faces' borders.
 SEW_TOL = 1e-6
@@ -194,10 +197,6 @@ def _wire(loop, edges):
     return w
 
 
-#: Kinds whose first surface parameter is an angle.
-_PERIODIC = ("cylinder", "cone", "sphere", "torus")
-
-
 def _trimmed(surface, wires, tolerance: float):
     """The surface bounded by ``wires`` (outer first), curves on it by ``ShapeFix_Face``."""
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
@@ -211,7 +210,7 @@ def _trimmed(surface, wires, tolerance: float):
     return fx.Face()
 
 
-def analytic_face(surface, boundary, edges, *, tolerance: float, name: str):
+def analytic_face(surface, boundary, edges, *, tolerance: float, name: str, curves=None):
     """The elementary surface trimmed by the boundary's wires.
 
     Parameters
@@ -225,6 +224,11 @@ def analytic_face(surface, boundary, edges, *, tolerance: float, name: str):
         Model units: the precision of the wire checks.
     name : str
         Names the face in errors (``"patch 4"``).
+    curves : list of (m_i, 3) float64, optional
+        The curves' samples: the curves on the surface of a sphere or torus face with
+        no seam (one bounded by arcs) are made from them (:mod:`curvenet.cad.pcurves`),
+        not by ``ShapeFix_Face``, which can take an arc in the wrong period there; a
+        band between two parallels and its seam is left to ``ShapeFix_Face``.
 
     Returns
     -------
@@ -238,8 +242,13 @@ def analytic_face(surface, boundary, edges, *, tolerance: float, name: str):
     from OCP.BRepTools import BRepTools
     from OCP.ShapeAnalysis import ShapeAnalysis_Wire
     wires = [_wire(lp, edges) for lp in boundary]
-    face = _trimmed(surface, wires, tolerance)
-    if surface.kind in _PERIODIC:
+    seam = any(len({e for e, _ in lp}) < len(lp) for lp in boundary)
+    if surface.kind in ("sphere", "torus") and curves is not None and not seam:
+        from .pcurves import pcurve_face
+        face = pcurve_face(_geom_surface, surface, boundary, edges, curves, tolerance)
+    else:
+        face = _trimmed(surface, wires, tolerance)
+    if surface.kind in ("cylinder", "cone") or seam:
         # turn the frame so the face starts at angle 0: its parameter range is then
         # within the surface's first period, as NURBS conversion (3DM) needs
         u0 = BRepTools.UVBounds_s(face)[0]
@@ -492,7 +501,7 @@ def brep_shape(model: CadModel):
             _check_plane_loops(s, model.boundaries[k], model.curves, model.name(k))
         of_patch.setdefault(k, []).append(len(faces))
         faces.append(analytic_face(s, model.boundaries[k], edges, tolerance=tol,
-                                   name=model.name(k)))
+                                   name=model.name(k), curves=model.curves))
         info.append({"patch": k, "kind": s.kind, "residual": float(s.residual / diag)})
     for pc, k in zip(occ_faces(model.pieces), model.piece_patch):
         of_patch.setdefault(int(k), []).append(len(faces))

@@ -133,7 +133,7 @@ def test_step_round_trip(tmp_path, make, closed, schema):
             assert s["angle"] < 1e-4
 
 
-@pytest.mark.parametrize("make", [shapes.latlong_sphere, shapes.l_prism, shapes.house])
+@pytest.mark.parametrize("make", [shapes.ellipsoid, shapes.l_prism, shapes.house])
 def test_irregular_shapes_graded_pieces_valid_and_close(tmp_path, make):
     """Extraordinary vertices (split patches, valence-6 centres): graded B-spline faces,
     valid closed solid, deviation well below 1e-4 of the diagonal, G1 below 1 degree."""
