@@ -482,16 +482,39 @@ def brep_shape(model: CadModel):
         surface, fraction of the diagonal); ``edges``: counts per curve kind;
         ``sew_tolerance`` (model units), ``sewing_free_edges``, ``volumes``,
         ``manifold_pieces``, ``shape_fixed`` (healed because the sewn shape was not
-        valid).
+        valid), ``pieced_for_validity`` (sphere and torus patches written as their
+        B-spline pieces because the shape with them trimmed was not valid; absent when
+        none).
 
     Raises
     ------
     CadInputError
         A face whose boundary crosses itself (named by its patch).
     """
+    shape, rep = _brep(model, CAD_KINDS)
+    pieced = {int(k) for k in model.piece_patch}
+    curved = [k for k, s in enumerate(model.surfaces)
+              if s is not None and s.kind in _DOUBLY_CURVED and k in pieced]
+    if curved and not is_valid(shape):
+        plain = tuple(k for k in CAD_KINDS if k not in _DOUBLY_CURVED)
+        shape2, rep2 = _brep(model, plain)
+        if is_valid(shape2):
+            rep2["pieced_for_validity"] = curved
+            return shape2, rep2
+    return shape, rep
+
+
+#: Kinds whose trimmed faces fall back to their B-spline pieces when the shape with them
+#: is not valid (their curves on the surface are made from samples).
+_DOUBLY_CURVED = ("sphere", "torus")
+
+
+def _brep(model: CadModel, kinds):
+    """:func:`brep_shape` with the patches of ``kinds`` as trimmed faces and the others
+    as their pieces (those with none are left out)."""
     diag = model.diagonal if model.diagonal > 0 else 1.0
     tol = max(SEW_TOL * diag, 2.0 * model.gap)
-    analytic = [k for k, s in enumerate(model.surfaces) if s is not None and s.kind in CAD_KINDS]
+    analytic = [k for k, s in enumerate(model.surfaces) if s is not None and s.kind in kinds]
     used = {e for k in analytic for lp in model.boundaries[k] for e, _ in lp}
     edges = curve_edges(model.curves, model.ends, model.positions, used, diagonal=diag)
     faces, info, of_patch = [], [], {}
@@ -503,7 +526,10 @@ def brep_shape(model: CadModel):
         faces.append(analytic_face(s, model.boundaries[k], edges, tolerance=tol,
                                    name=model.name(k), curves=model.curves))
         info.append({"patch": k, "kind": s.kind, "residual": float(s.residual / diag)})
+    trimmed = set(analytic)
     for pc, k in zip(occ_faces(model.pieces), model.piece_patch):
+        if int(k) in trimmed:
+            continue
         of_patch.setdefault(int(k), []).append(len(faces))
         faces.append(pc)
         info.append({"patch": int(k), "kind": "bspline", "residual": None})
