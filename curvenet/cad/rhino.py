@@ -210,6 +210,25 @@ def _close_loop(curves) -> None:
         b.Points[0] = rhino3dm.Point4d(x * pb.W, y * pb.W, 0.0, pb.W)
 
 
+def _singular_lines(c2, trims, tis) -> None:
+    """A singular trim's curve made the straight line along the collapsed side, from the
+    previous trim's end to the next one's start (NURBS conversion can leave it a point,
+    which openNURBS rejects)."""
+    import rhino3dm
+    for k, t in enumerate(tis):
+        if trims[t]["ei"] >= 0:
+            continue
+        prev, nxt = c2[trims[tis[k - 1]]["c2i"]], c2[trims[tis[(k + 1) % len(tis)]]["c2i"]]
+        a, b = prev.Points[len(prev.Points) - 1], nxt.Points[0]
+        t0, t1 = trims[t]["dom"]
+        line = rhino3dm.NurbsCurve(2, False, 2, 2)
+        line.Points[0] = rhino3dm.Point4d(a.X / a.W, a.Y / a.W, 0.0, 1.0)
+        line.Points[1] = rhino3dm.Point4d(b.X / b.W, b.Y / b.W, 0.0, 1.0)
+        line.Knots[0], line.Knots[1] = t0, (t1 if t1 > t0 else t0 + 1.0)
+        c2[trims[t]["c2i"]] = line
+        trims[t]["dom"] = _domain(line)
+
+
 def _domain(c) -> tuple:
     d = c.Domain
     return float(d.T0), float(d.T1)
@@ -292,6 +311,7 @@ def brep_bytes(shape, tolerance: float) -> bytes:
                 c2.append(curve)
                 tis.append(ti)
                 we.Next()
+            _singular_lines(c2, trims, tis)
             _close_loop([c2[trims[t]["c2i"]] for t in tis])
             for t in tis:           # openNURBS checks the flag against the final curve
                 trims[t]["iso"] = _iso(c2[trims[t]["c2i"]], surfaces[-1])
