@@ -314,7 +314,7 @@ def _surface_one(inp: str, out: str, args) -> dict:
                       seed=args.seed, progress=not args.no_progress,
                       classical_options=_classical_options(args),
                       neural_options=_neural_options(args), points=_points(args))
-        res.save(out, schema=args.step_schema)
+        _save(res, out, args, inputs=[inp, args.patches])
         if args.preview:
             from .view.preview import render_preview
             prev = args.preview if args.output else str(Path(out).with_suffix(".png"))
@@ -333,6 +333,28 @@ def _surface_one(inp: str, out: str, args) -> dict:
     except CurvenetError as err:
         return {"input": inp, "output": out, "status": "error", "error": _naming(err, inp),
                 "seconds": time.perf_counter() - t0}
+
+
+def _save(res, out: str, args, *, inputs) -> None:
+    """Write the result; when only a CAD export fails, the mesh still goes beside it
+    (``OUT`` with ``.obj``, ``-mesh.obj`` where that is an input) and the failure names
+    where it is."""
+    from .pipeline import CAD_FORMATS
+    if Path(out).suffix.lower() not in CAD_FORMATS:
+        res.save(out, schema=args.step_schema)
+        return
+    try:
+        res.save(out, schema=args.step_schema)
+    except Exception as err:
+        mesh = Path(out).with_suffix(".obj")
+        given = {Path(i).resolve() for i in inputs if i}
+        if mesh.resolve() in given:
+            mesh = mesh.with_name(mesh.stem + "-mesh.obj")
+        res.save(mesh)
+        note = f"; no {Path(out).suffix.lower()} written, the mesh is in {mesh}"
+        if isinstance(err, CurvenetError):
+            raise CurvenetError(f"{err}{note}") from None
+        raise RuntimeError(f"CAD export: {type(err).__name__}: {err}{note}") from err
 
 
 def _cmd_surface(args) -> int:

@@ -168,9 +168,18 @@ def export_cad(path, result: SurfaceResult, *, schema: str = "AP214",
             f"their plane, and analytic faces are off (classical_options analytic_tol=None): "
             f"their control mesh covers the outer loop only; save a mesh format")
     loop_patch = rep.get("loop_patch", list(range(len(ps.patches))))
-    bset = extract_bsplines(result.control_net, DEFAULT_LEVEL if level is None else level)
+    # pieces of the faces not trimmed, and of spheres and tori (the B-rep may fall back
+    # to them); without those where they cannot be extracted (a dome's polar patch)
+    lv = DEFAULT_LEVEL if level is None else level
+    plain = [s is not None and s.kind in ("plane", "cylinder", "cone") for s in surfaces]
     trimmed = [s is not None and s.kind in cad.CAD_KINDS for s in surfaces]
-    free = [pc for pc in bset.pieces if not trimmed[loop_patch[pc.patch]]]
+    try:
+        bset = extract_bsplines(result.control_net, lv,
+                                skip=[i for i, k in enumerate(loop_patch) if plain[k]])
+    except ValueError:
+        bset = extract_bsplines(result.control_net, lv,
+                                skip=[i for i, k in enumerate(loop_patch) if trimmed[k]])
+    free = bset.pieces
     diag = bset.report.get("diagonal", 1.0)
     gap = max([s["gap"] for s in bset.seams] + [rep.get("max_curve_deviation", 0.0)]) * diag
     model = cad.CadModel(

@@ -140,7 +140,7 @@ def _exact_in(sites, chains, own, pid: int, M: int, N: int):
 
 def extract_bsplines(net: ControlNet, level: int = DEFAULT_LEVEL, *, sample_levels: int = 2,
                      grade: int = DEFAULT_GRADE, max_grade: int = MAX_GRADE,
-                     tolerance: float = DEFAULT_TOLERANCE) -> BSplineSet:
+                     tolerance: float = DEFAULT_TOLERANCE, skip=()) -> BSplineSet:
     """Bicubic B-spline pieces of the limit surface of ``net``, with a seam report.
 
     Parameters
@@ -162,6 +162,9 @@ def extract_bsplines(net: ControlNet, level: int = DEFAULT_LEVEL, *, sample_leve
         grade at a time up to this (high valences shrink slowly under subdivision).
     tolerance : float
         Target deviation, fraction of the diagonal.
+    skip : iterable of int
+        Patches (of ``net``) whose pieces are not wanted (faces written otherwise, such
+        as trimmed analytic ones): neither extracted nor in the seam report.
 
     Returns
     -------
@@ -173,7 +176,15 @@ def extract_bsplines(net: ControlNet, level: int = DEFAULT_LEVEL, *, sample_leve
             raise ValueError(f"{name}: expected an integer >= {lo}, got {val!r}")
     diag = net.diagonal if net.diagonal > 0 else 1.0
     patches, lv, grids, limit = subdivide_net(net, int(level))
+    skip = {int(k) for k in skip}
+    keep = [i for i, p in enumerate(patches) if int(p) not in skip]
+    patches, grids = [patches[i] for i in keep], [grids[i] for i in keep]
     r = 2 ** int(sample_levels)
+    if not grids:
+        return BSplineSet([], [], {"level": int(level), "sample_levels": int(sample_levels),
+                                   "grade": int(grade), "grades_used": [], "diagonal": diag,
+                                   "n_pieces": 0, "n_exact": 0, "max_deviation": 0.0,
+                                   "pieces_per_patch": {}})
     nets, offs = [], []
     for G in grids:                    # uniform poles; irregular: vertices off the limit
         M, N = G.shape[0] - 1, G.shape[1] - 1

@@ -281,9 +281,16 @@ def analytic_faces(curves, boundaries, *, tol: float = ANALYTIC_TOL, flat=None, 
     return out
 
 
-def _on_surfaces(V, F, face_patch, surfaces):
+def _on_surfaces(V, F, face_patch, surfaces, heights=None):
     """Vertices of the faces of each analytic patch that no other patch uses, projected
-    onto its surface: (n, 3) float64 (a copy)."""
+    onto its surface: (n, 3) float64 (a copy).
+
+    ``heights`` (per patch ``(lo, hi)`` or None): the range along a cylinder's or
+    cone's axis of the patch's boundary. Their vertices are brought within it and then
+    onto the surface at the same angle about the axis (a fitted band that sagged away
+    from its border circles would otherwise be projected onto the surface's
+    continuation beyond them).
+    """
     V = np.array(V, dtype=np.float64)
     pairs = np.unique(np.c_[np.asarray(F).ravel(), np.repeat(face_patch, 3)], axis=0)
     count = np.bincount(pairs[:, 0], minlength=len(V))
@@ -293,8 +300,36 @@ def _on_surfaces(V, F, face_patch, surfaces):
     for p, s in enumerate(surfaces):
         if s is not None:
             ids = np.flatnonzero(owner == p)
-            V[ids] = s.project(V[ids])
+            if heights is not None and heights[p] is not None and s.kind in _AXIAL:
+                # at the same angle, within the border's heights, onto the surface
+                d = V[ids] - s.origin
+                z = np.clip(d @ s.axis, *heights[p])
+                r = d - (d @ s.axis)[:, None] * s.axis
+                n = np.linalg.norm(r, axis=1, keepdims=True)
+                unit = np.where(n > 0, r / np.maximum(n, 1e-300), s.xdir)
+                rho = s.radius + (z * np.tan(s.minor) if s.kind == "cone" else 0.0)
+                V[ids] = s.origin + z[:, None] * s.axis + np.asarray(rho).reshape(-1, 1) * unit
+            else:
+                V[ids] = s.project(V[ids])
     return V
+
+
+#: Kinds whose points are kept within their boundary's extent along the axis.
+_AXIAL = ("cylinder", "cone")
+
+
+def _heights(curves, boundaries, surfaces) -> list:
+    """Per patch the ``(lo, hi)`` extent of its boundary samples along its cylinder's or
+    cone's axis; None for other patches."""
+    out = []
+    for b, s in zip(boundaries, surfaces):
+        if s is None or s.kind not in _AXIAL:
+            out.append(None)
+            continue
+        p = np.concatenate([np.asarray(curves[c], np.float64) for lp in b for c, _ in lp])
+        z = (p - s.origin) @ s.axis
+        out.append((float(z.min()), float(z.max())))
+    return out
 
 
 def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: float = FLAT_TOL,
@@ -348,7 +383,7 @@ def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: f
     if analytic_tol is not None:
         surfaces = analytic_faces(curves, boundaries, tol=analytic_tol, flat=flat,
                                   normals=normals, offsets=offsets)
-        V = _on_surfaces(V, F, face_patch, surfaces)
+        V = _on_surfaces(V, F, face_patch, surfaces, _heights(curves, boundaries, surfaces))
     report = dict(res.report, n_patches=len(boundaries), n_sectors=len(loops),
                   cuts=len(all_curves) - n, flat_patches=int(flat.sum()),
                   flat_meshed=int(meshed.sum()), n_faces=len(F), unsplit_holes=unsplit,

@@ -5,7 +5,11 @@ arc (a full circle for a closed curve) or a B-spline approximating its samples
 (:func:`curve_edges`). A patch whose boundary lies on a plane, cylinder, cone, sphere
 or torus (:mod:`curvenet.surfacing.analytic`) becomes that surface trimmed by wires
 of those edges, an outer wire and one per hole, a seam edge twice in one wire
-(:func:`analytic_face`); ``ShapeFix_Face`` computes the curves on the surface. The
+(:func:`analytic_face`); ``ShapeFix_Face`` computes the curves on the surface of planes,
+cylinders, cones and seam faces, framed so the face starts at angle 0, and those of
+sphere and torus faces bounded by arcs are made from the curves' samples
+(:mod:`curvenet.cad.pcurves`). A planar loop that
+crosses itself is bad input (:class:`CadInputError`, naming the patch). The
 other patches keep their B-spline faces (the Catmull-Clark limit pieces,
 :func:`curvenet.cad.export.occ_faces`). :func:`build_solids` sews all faces per
 manifold piece (faces meeting along the curves they share), turns each closed shell
@@ -18,7 +22,7 @@ it inside the functions.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -35,10 +39,9 @@ EDGE_TOL = 1e-6
 #: the curve's extent).
 LINE_TOL = 1e-7
 
-#: Analytic kinds written as trimmed elementary faces. Spheres and tori are written as
-#: their B-spline pieces: OpenCascade's curves-on-surface of arcs on them
-#: (``ShapeFix_Face``) can take the wrong period, trimming the complement of the face.
-CAD_KINDS = ("plane", "cylinder", "cone")
+#: Analytic kinds written as trimmed elementary faces (spheres and tori with their
+#: curves on the surface made from the samples, :mod:`curvenet.cad.pcurves`).
+CAD_KINDS = ("plane", "cylinder", "cone", "sphere", "torus")
 #: Sewing tolerance as a fraction of the diagonal, never below twice the largest gap
 #: between neighbouring faces' borders.
 SEW_TOL = 1e-6
@@ -109,8 +112,13 @@ def _spline_edge(c, v0, v1, tol):
     arr = Array1_gp_Pnt(1, len(c))
     for i, p in enumerate(c, 1):
         arr.SetValue(i, _pnt(p))
-    fit = GeomAPI_PointsToBSpline(arr, 3, 8, GeomAbs_C2, float(tol))
-    return BRepBuilderAPI_MakeEdge(fit.Curve(), v0, v1).Edge()
+    bs = GeomAPI_PointsToBSpline(arr, 3, 8, GeomAbs_C2, float(tol)).Curve()
+    bs.SetPole(1, _pnt(c[0]))             # clamped: the end poles are the ends, made exact
+    bs.SetPole(bs.NbPoles(), _pnt(c[-1]))
+    mk = BRepBuilderAPI_MakeEdge(bs, v0, v1, bs.FirstParameter(), bs.LastParameter())
+    if not mk.IsDone():
+        raise CadInputError(f"no edge along its {len(c)} samples ({mk.Error().name})")
+    return mk.Edge()
 
 
 def curve_edges(curves, ends, positions, used, *, diagonal: float) -> dict:
@@ -153,7 +161,10 @@ def curve_edges(curves, ends, positions, used, *, diagonal: float) -> dict:
         if arc is not None:
             out[i] = (arc, "circle")
             continue
-        out[i] = (_spline_edge(c, verts[u], verts[v], EDGE_TOL * diagonal), "bspline")
+        try:
+            out[i] = (_spline_edge(c, verts[u], verts[v], EDGE_TOL * diagonal), "bspline")
+        except CadInputError as err:
+            raise CadInputError(f"curve {i}: {err}") from None
     return out
 
 
@@ -186,7 +197,20 @@ def _wire(loop, edges):
     return w
 
 
-def analytic_face(surface, boundary, edges, *, tolerance: float, name: str):
+def _trimmed(surface, wires, tolerance: float):
+    """The surface bounded by ``wires`` (outer first), curves on it by ``ShapeFix_Face``."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
+    from OCP.ShapeFix import ShapeFix_Face
+    mk = BRepBuilderAPI_MakeFace(_geom_surface(surface), wires[0], True)
+    for w in wires[1:]:
+        mk.Add(w)
+    fx = ShapeFix_Face(mk.Face())
+    fx.SetPrecision(tolerance)
+    fx.Perform()
+    return fx.Face()
+
+
+def analytic_face(surface, boundary, edges, *, tolerance: float, name: str, curves=None):
     """The elementary surface trimmed by the boundary's wires.
 
     Parameters
@@ -200,6 +224,11 @@ def analytic_face(surface, boundary, edges, *, tolerance: float, name: str):
         Model units: the precision of the wire checks.
     name : str
         Names the face in errors (``"patch 4"``).
+    curves : list of (m_i, 3) float64, optional
+        The curves' samples: the curves on the surface of a sphere or torus face with
+        no seam (one bounded by arcs) are made from them (:mod:`curvenet.cad.pcurves`),
+        not by ``ShapeFix_Face``, which can take an arc in the wrong period there; a
+        band between two parallels and its seam is left to ``ShapeFix_Face``.
 
     Returns
     -------
@@ -210,23 +239,81 @@ def analytic_face(surface, boundary, edges, *, tolerance: float, name: str):
     CadInputError
         A loop crosses itself on the surface.
     """
-    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
+    from OCP.BRepTools import BRepTools
     from OCP.ShapeAnalysis import ShapeAnalysis_Wire
-    from OCP.ShapeFix import ShapeFix_Face
     wires = [_wire(lp, edges) for lp in boundary]
-    mk = BRepBuilderAPI_MakeFace(_geom_surface(surface), wires[0], True)
-    for w in wires[1:]:
-        mk.Add(w)
-    fx = ShapeFix_Face(mk.Face())
-    fx.SetPrecision(tolerance)
-    fx.Perform()
-    face = fx.Face()
+    seam = any(len({e for e, _ in lp}) < len(lp) for lp in boundary)
+    if surface.kind in ("sphere", "torus") and curves is not None and not seam:
+        from .pcurves import pcurve_face
+        face = pcurve_face(_geom_surface, surface, boundary, edges, curves, tolerance)
+    else:
+        face = _trimmed(surface, wires, tolerance)
+    if surface.kind in ("cylinder", "cone") or seam:
+        # turn the frame so the face starts at angle 0: its parameter range is then
+        # within the surface's first period, as NURBS conversion (3DM) needs
+        u0 = BRepTools.UVBounds_s(face)[0]
+        if abs(u0) > 1e-12:
+            x = np.cos(u0) * surface.xdir + np.sin(u0) * surface.ydir
+            face = _trimmed(replace(surface, xdir=x / np.linalg.norm(x)), wires, tolerance)
     for k, w in enumerate(wires):
         sa = ShapeAnalysis_Wire(w, face, tolerance)
         if sa.CheckSelfIntersection():
             where = "outer loop" if k == 0 else f"hole {k}"
             raise CadInputError(f"{name}: its {where} crosses itself on its {surface.kind}")
     return face
+
+
+def _loop_points(loop, curves) -> np.ndarray:
+    """The samples of a loop of ``(curve id, forward)`` in walking order: (n, 3) float64."""
+    parts = [np.asarray(curves[e], np.float64)[:: 1 if fwd else -1][:-1] for e, fwd in loop]
+    return np.concatenate(parts)
+
+
+def _crossings(xy) -> np.ndarray:
+    """Pairs ``(i, j)`` of non-neighbouring segments of the closed polygon ``xy (n, 2)``
+    that cross or touch: (k, 2) int64."""
+    n = len(xy)
+    a, b = xy, np.roll(xy, -1, axis=0)
+
+    def orient(p, q, r):        # (n, n) signs of the turn p -> q -> r
+        return np.sign((q[..., 0] - p[..., 0]) * (r[..., 1] - p[..., 1])
+                       - (q[..., 1] - p[..., 1]) * (r[..., 0] - p[..., 0]))
+    def on(p, q, r, o):         # r on segment p-q, given the turn o of p -> q -> r
+        lo, hi = np.minimum(p, q), np.maximum(p, q)
+        return (o == 0) & ((lo <= r) & (r <= hi)).all(axis=-1)
+    C, D = a[None], b[None]
+    out = []
+    for s in range(0, n, _CROSS_BLOCK):         # (block, n) tests at a time
+        A, B = a[s:s + _CROSS_BLOCK, None], b[s:s + _CROSS_BLOCK, None]
+        o1, o2, o3, o4 = orient(A, B, C), orient(A, B, D), orient(C, D, A), orient(C, D, B)
+        hit = ((o1 * o2 < 0) & (o3 * o4 < 0)) | on(A, B, C, o1) | on(A, B, D, o2) \
+            | on(C, D, A, o3) | on(C, D, B, o4)
+        i, j = np.nonzero(hit)
+        i = i + s
+        keep = (j >= i + 2) & ~((i == 0) & (j == n - 1))   # neighbours share an end
+        out.append(np.c_[i[keep], j[keep]])
+    return np.concatenate(out) if out else np.zeros((0, 2), np.int64)
+
+
+#: Rows of segment pairs tested at once by :func:`_crossings`.
+_CROSS_BLOCK = 256
+
+
+def _check_plane_loops(surface, boundary, curves, name: str) -> None:
+    """Raise :class:`CadInputError` when a planar face's loop crosses itself or another
+    of its loops (in the plane's frame)."""
+    loops = [_loop_points(lp, curves) for lp in boundary]
+    frame = np.stack([surface.xdir, surface.ydir], axis=1)
+    for k, p in enumerate(loops):
+        if len(p) >= 4 and len(_crossings((p - surface.origin) @ frame)):
+            where = "outer loop" if k == 0 else f"hole {k}"
+            raise CadInputError(f"{name}: its {where} crosses itself")
+    if len(loops) > 1:
+        from matplotlib.path import Path
+        outer = Path((loops[0] - surface.origin) @ frame)
+        for k, p in enumerate(loops[1:], 1):
+            if not outer.contains_points((p - surface.origin) @ frame).all():
+                raise CadInputError(f"{name}: its hole {k} crosses its outer loop")
 
 
 def face_kinds(shape) -> list:
@@ -395,26 +482,54 @@ def brep_shape(model: CadModel):
         surface, fraction of the diagonal); ``edges``: counts per curve kind;
         ``sew_tolerance`` (model units), ``sewing_free_edges``, ``volumes``,
         ``manifold_pieces``, ``shape_fixed`` (healed because the sewn shape was not
-        valid).
+        valid), ``pieced_for_validity`` (sphere and torus patches written as their
+        B-spline pieces because the shape with them trimmed was not valid; absent when
+        none).
 
     Raises
     ------
     CadInputError
         A face whose boundary crosses itself (named by its patch).
     """
+    shape, rep = _brep(model, CAD_KINDS)
+    pieced = {int(k) for k in model.piece_patch}
+    curved = [k for k, s in enumerate(model.surfaces)
+              if s is not None and s.kind in _DOUBLY_CURVED and k in pieced]
+    if curved and not is_valid(shape):
+        plain = tuple(k for k in CAD_KINDS if k not in _DOUBLY_CURVED)
+        shape2, rep2 = _brep(model, plain)
+        if is_valid(shape2):
+            rep2["pieced_for_validity"] = curved
+            return shape2, rep2
+    return shape, rep
+
+
+#: Kinds whose trimmed faces fall back to their B-spline pieces when the shape with them
+#: is not valid (their curves on the surface are made from samples).
+_DOUBLY_CURVED = ("sphere", "torus")
+
+
+def _brep(model: CadModel, kinds):
+    """:func:`brep_shape` with the patches of ``kinds`` as trimmed faces and the others
+    as their pieces (those with none are left out)."""
     diag = model.diagonal if model.diagonal > 0 else 1.0
     tol = max(SEW_TOL * diag, 2.0 * model.gap)
-    analytic = [k for k, s in enumerate(model.surfaces) if s is not None and s.kind in CAD_KINDS]
+    analytic = [k for k, s in enumerate(model.surfaces) if s is not None and s.kind in kinds]
     used = {e for k in analytic for lp in model.boundaries[k] for e, _ in lp}
     edges = curve_edges(model.curves, model.ends, model.positions, used, diagonal=diag)
     faces, info, of_patch = [], [], {}
     for k in analytic:
         s = model.surfaces[k]
+        if s.kind == "plane":
+            _check_plane_loops(s, model.boundaries[k], model.curves, model.name(k))
         of_patch.setdefault(k, []).append(len(faces))
         faces.append(analytic_face(s, model.boundaries[k], edges, tolerance=tol,
-                                   name=model.name(k)))
+                                   name=model.name(k), curves=model.curves))
         info.append({"patch": k, "kind": s.kind, "residual": float(s.residual / diag)})
+    trimmed = set(analytic)
     for pc, k in zip(occ_faces(model.pieces), model.piece_patch):
+        if int(k) in trimmed:
+            continue
         of_patch.setdefault(int(k), []).append(len(faces))
         faces.append(pc)
         info.append({"patch": int(k), "kind": "bspline", "residual": None})

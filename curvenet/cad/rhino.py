@@ -39,7 +39,7 @@ _BREP_UUID = bytes.fromhex("c5dbb56060e6d311bfe40010830122f0")
 ARCHIVE_VERSION = 60
 _OPENNURBS_VERSION = -1869833980
 #: ``ON_BrepTrim`` types and ``ON_BrepLoop`` types.
-_MATED, _SEAM, _BOUNDARY = 2, 3, 1
+_MATED, _SEAM, _BOUNDARY, _SINGULAR = 2, 3, 1, 4
 _OUTER, _INNER = 1, 2
 
 
@@ -147,28 +147,54 @@ def _bspline2d(edge, face):
     return bs
 
 
-#: ``ON_Surface::ISO`` flags of the W, S, E, N sides (a trim inside the domain is
-#: written as not iso: openNURBS checks the side flags only).
-_W_ISO, _S_ISO, _E_ISO, _N_ISO = 3, 4, 5, 6
-#: A trim is isoparametric when its control points' u (or v) agree to this fraction of
-#: the surface's parameter range.
-ISO_TOL = 1e-12
+#: ``ON_Surface::ISO`` flags: interior ``u`` / ``v`` = constant, the W, S, E, N sides.
+_X_ISO, _Y_ISO, _W_ISO, _S_ISO, _E_ISO, _N_ISO = 1, 2, 3, 4, 5, 6
+#: openNURBS's ``ON_SQRT_EPSILON`` and ``ON_ZERO_TOLERANCE``, which its iso test uses.
+_ON_SQRT_EPSILON, _ON_ZERO_TOLERANCE = 1.490116119385e-8, 2.3283064365386962890625e-10
+
+
+def _parameter_tolerance(t0: float, t1: float, t: float) -> tuple:
+    """``ON_GetParameterTolerance``: the interval around ``t`` counted as ``t``."""
+    t = min(max(t, t0), t1)
+    dt = (t1 - t0) * 8.0 * _ON_SQRT_EPSILON + (abs(t0) + abs(t1)) * _ON_ZERO_TOLERANCE
+    return t - dt, t + dt
 
 
 def _iso(curve, surface) -> int:
-    """The ``m_iso`` side flag openNURBS checks a trim against, or 0."""
+    """The ``m_iso`` flag openNURBS expects of a trim (``ON_Surface::IsIsoparametric``
+    of the trim curve: its control points' box against the surface's domain, then
+    straightness), or 0."""
     uv = np.array([[p.X / p.W, p.Y / p.W] for p in
                    (curve.Points[i] for i in range(len(curve.Points)))])
-    for k, (lo_side, hi_side) in enumerate(((_W_ISO, _E_ISO), (_S_ISO, _N_ISO))):
-        d = surface.Domain(k)
-        eps = ISO_TOL * max(abs(d.T1 - d.T0), 1e-300)
-        if np.ptp(uv[:, k]) <= eps:
-            x = uv[0, k]
-            if abs(x - d.T0) <= eps:
-                return lo_side
-            if abs(x - d.T1) <= eps:
-                return hi_side
-    return 0
+    lo, hi = uv.min(axis=0), uv.max(axis=0)
+    ext = hi - lo
+    (s0, s1), (t0, t1) = (_domain_of(surface, k) for k in (0, 1))
+    tol = np.array([(s1 - s0) / 32.0, (t1 - t0) / 32.0])
+    if not (s0 < s1 and t0 < t1 and (ext <= tol).any()):
+        return 0
+    k = 0 if ext[0] * (t1 - t0) <= ext[1] * (s1 - s0) else 1
+    a0, a1 = (s0, s1) if k == 0 else (t0, t1)
+    low, high, inner = ((_W_ISO, _E_ISO, _X_ISO) if k == 0 else (_S_ISO, _N_ISO, _Y_ISO))
+    iso = 0
+    if hi[k] <= a0 + tol[k]:
+        a, b = _parameter_tolerance(a0, a1, a0)
+        iso = low if a <= lo[k] and hi[k] <= b else 0
+    elif lo[k] >= a1 - tol[k]:
+        a, b = _parameter_tolerance(a0, a1, a1)
+        iso = high if a <= lo[k] and hi[k] <= b else 0
+    if not iso and (a0 < hi[k] or lo[k] < a1):
+        a, b = _parameter_tolerance(a0, a1, 0.5 * (lo[k] + hi[k]))
+        iso = inner if a <= lo[k] and hi[k] <= b else 0
+    if iso and not (ext[k] < _ON_ZERO_TOLERANCE
+                    and _ON_ZERO_TOLERANCE * 1024.0 <= ext[1 - k]):
+        if not curve.IsLinear(float(ext[k])):
+            iso = 0
+    return iso
+
+
+def _domain_of(surface, k: int) -> tuple:
+    d = surface.Domain(k)
+    return min(d.T0, d.T1), max(d.T0, d.T1)
 
 
 def _close_loop(curves) -> None:
@@ -182,6 +208,25 @@ def _close_loop(curves) -> None:
         y = 0.5 * (pa.Y / pa.W + pb.Y / pb.W)
         a.Points[len(a.Points) - 1] = rhino3dm.Point4d(x * pa.W, y * pa.W, 0.0, pa.W)
         b.Points[0] = rhino3dm.Point4d(x * pb.W, y * pb.W, 0.0, pb.W)
+
+
+def _singular_lines(c2, trims, tis) -> None:
+    """A singular trim's curve made the straight line along the collapsed side, from the
+    previous trim's end to the next one's start (NURBS conversion can leave it a point,
+    which openNURBS rejects)."""
+    import rhino3dm
+    for k, t in enumerate(tis):
+        if trims[t]["ei"] >= 0:
+            continue
+        prev, nxt = c2[trims[tis[k - 1]]["c2i"]], c2[trims[tis[(k + 1) % len(tis)]]["c2i"]]
+        a, b = prev.Points[len(prev.Points) - 1], nxt.Points[0]
+        t0, t1 = trims[t]["dom"]
+        line = rhino3dm.NurbsCurve(2, False, 2, 2)
+        line.Points[0] = rhino3dm.Point4d(a.X / a.W, a.Y / a.W, 0.0, 1.0)
+        line.Points[1] = rhino3dm.Point4d(b.X / b.W, b.Y / b.W, 0.0, 1.0)
+        line.Knots[0], line.Knots[1] = t0, (t1 if t1 > t0 else t0 + 1.0)
+        c2[trims[t]["c2i"]] = line
+        trims[t]["dom"] = _domain(line)
 
 
 def _domain(c) -> tuple:
@@ -222,12 +267,15 @@ def brep_bytes(shape, tolerance: float) -> bytes:
     V, E, F = (maps[k] for k in (TopAbs_VERTEX, TopAbs_EDGE, TopAbs_FACE))
     pts = np.array([[p.X(), p.Y(), p.Z()] for p in
                     (BRep_Tool.Pnt_s(TopoDS.Vertex(V.FindKey(i))) for i in range(1, V.Size() + 1))])
-    c3, edges = [], []
+    c3, edges, edge_of = [], [], {}
     for i in range(1, E.Size() + 1):
         e = TopoDS.Edge(E.FindKey(i))
         e = TopoDS.Edge(e.Oriented(TopAbs_FORWARD))
+        if BRep_Tool.Degenerated_s(e):      # a pole or an apex: a singular trim, no edge
+            continue
         curve = _on_curve(_bspline3d(e), 3)
         vi = [V.FindIndex(TopExp.FirstVertex_s(e)) - 1, V.FindIndex(TopExp.LastVertex_s(e)) - 1]
+        edge_of[i - 1] = len(edges)
         c3.append(curve)
         edges.append({"vi": vi, "ti": [], "dom": _domain(curve)})
     c2, trims, loops, faces, surfaces = [], [], [], [], []
@@ -248,25 +296,32 @@ def brep_bytes(shape, tolerance: float) -> bytes:
             we = BRepTools_WireExplorer(w, face)
             while we.More():
                 e = we.Current()
-                ei = E.FindIndex(e) - 1
+                ei = edge_of.get(E.FindIndex(e) - 1, -1)
                 rev = e.Orientation() == TopAbs_REVERSED
                 curve = _on_curve(_bspline2d(e, face), 2)
                 seam = BRep_Tool.IsClosed_s(e, face)
                 ti = len(trims)
-                vi = edges[ei]["vi"][::-1] if rev else edges[ei]["vi"]
+                if ei < 0:
+                    vi = [V.FindIndex(TopExp.FirstVertex_s(e)) - 1] * 2
+                else:
+                    vi = edges[ei]["vi"][::-1] if rev else edges[ei]["vi"]
+                    edges[ei]["ti"].append(ti)
                 trims.append({"c2i": len(c2), "ei": ei, "vi": vi, "rev": int(rev),
-                              "seam": seam, "li": li, "dom": _domain(curve),
-                              "iso": _iso(curve, surfaces[-1])})
+                              "seam": seam, "li": li, "dom": _domain(curve)})
                 c2.append(curve)
-                edges[ei]["ti"].append(ti)
                 tis.append(ti)
                 we.Next()
+            _singular_lines(c2, trims, tis)
             _close_loop([c2[trims[t]["c2i"]] for t in tis])
+            for t in tis:           # openNURBS checks the flag against the final curve
+                trims[t]["iso"] = _iso(c2[trims[t]["c2i"]], surfaces[-1])
             loops.append({"ti": tis, "type": _OUTER if not lis else _INNER, "fi": fi - 1})
             lis.append(li)
         faces.append({"li": lis, "si": fi - 1, "rev": int(face0.Orientation() == TopAbs_REVERSED)})
     for t in trims:
-        if not t["seam"]:
+        if t["ei"] < 0:
+            t["type"] = _SINGULAR
+        elif not t["seam"]:
             t["type"] = _MATED if len(edges[t["ei"]]["ti"]) >= 2 else _BOUNDARY
         else:
             t["type"] = _SEAM

@@ -35,20 +35,50 @@ from ..model.patchset import Patch
 __all__ = ["seam_patches", "seam_chains"]
 
 
+def _loops_of(patch, ends) -> list:
+    """The loops of a patch as sorted edge-id tuples: its outer loop and holes, or for a
+    seam face (edges listed twice) the one or two loops beside its seam."""
+    counts: dict = {}
+    for e in patch.edges:
+        counts[e] = counts.get(e, 0) + 1
+    if max(counts.values(), default=1) < 2:
+        return [tuple(sorted(lp)) for lp in (patch.edges, *patch.holes)]
+    once = [e for e, c in counts.items() if c == 1]
+    parent = {e: e for e in once}
+
+    def root(e):
+        while parent[e] != e:
+            e = parent[e]
+        return e
+    by_vertex: dict = {}
+    for e in once:
+        for x in ends[e]:
+            if x in by_vertex:
+                parent[root(e)] = root(by_vertex[x])
+            else:
+                by_vertex[x] = e
+    groups: dict = {}
+    for e in once:
+        groups.setdefault(root(e), []).append(e)
+    return [tuple(sorted(g)) for g in groups.values()]
+
+
 def seam_chains(network: CurveNetwork, patches) -> list:
-    """Chains of unused curves between two patch loops.
+    """Chains of unused curves between two patch loops, or from one to an apex.
 
     Parameters
     ----------
     network : CurveNetwork
     patches : list of Patch
+        Seam faces among them count by the loops beside their seams.
 
     Returns
     -------
     list of (seam, loop_a, loop_b)
         ``seam`` the chain's edge ids from its end on ``loop_a`` to its end on
-        ``loop_b`` (sorted edge-id tuples of the patch loops they end on), in the order
-        of the chains' smallest edge ids.
+        ``loop_b`` (sorted edge-id tuples of the patch loops they end on; ``loop_b``
+        empty for a chain ending at an *apex*, a junction of that one curve on no loop:
+        a cone's tip, a dome's pole), in the order of the chains' smallest edge ids.
     """
     ne = network.number_of_edges
     ends = [(e.u, e.v) for e in network.edges]
@@ -61,10 +91,10 @@ def seam_chains(network: CurveNetwork, patches) -> list:
         at.setdefault(v, []).append(i)
     loops_at: dict = {}
     for p in patches:
-        for lp in (p.edges, *p.holes):
+        for lp in _loops_of(p, ends):
             for e in lp:
                 for x in ends[e]:
-                    loops_at.setdefault(x, set()).add(tuple(lp))
+                    loops_at.setdefault(x, set()).add(lp)
     seen = np.zeros(ne, bool)
     out = []
     for i in range(ne):
@@ -74,13 +104,19 @@ def seam_chains(network: CurveNetwork, patches) -> list:
         if chain is None:
             continue
         la, lb = (loops_at.get(t, set()) for t in tips)
-        if len(la) != 1 or len(lb) != 1:
+        if not la and len(at[tips[0]]) == 1:       # the apex first: turn the chain round
+            la, lb, chain, tips = lb, la, chain[::-1], tips[::-1]
+        apex = not lb and len(at[tips[1]]) == 1
+        if len(la) != 1 or (len(lb) != 1 and not apex):
             continue
-        (a,), (b,) = la, lb
+        (a,) = la
+        b = () if apex else next(iter(lb))
         va = {x for e in a for x in ends[e]}
         vb = {x for e in b for x in ends[e]}
         inner = {x for e in chain for x in ends[e]} - set(tips)
-        if a == b or va & vb or inner & set(loops_at) or not _facing(network, a, b):
+        if a == b or va & vb or inner & set(loops_at):
+            continue
+        if not (_pointing(network, a, tips[1]) if apex else _facing(network, a, b)):
             continue
         out.append((chain, a, b))
     return out
@@ -112,6 +148,15 @@ def _facing(network: CurveNetwork, a, b) -> bool:
     chord = cb - ca
     length = float(np.linalg.norm(chord))
     return length > 0 and abs(float(chord @ n)) >= _FACING_COS * length * np.linalg.norm(n)
+
+
+def _pointing(network: CurveNetwork, a, tip) -> bool:
+    """Whether junction ``tip`` lies off loop ``a``'s plane as a cone's apex or a dome's
+    pole does: the line from the loop's centre to it within 45 degrees of the normal."""
+    c, n = _frame(network, a)
+    chord = network.positions[tip] - c
+    length = float(np.linalg.norm(chord))
+    return length > 0 and abs(float(chord @ n)) >= _FACING_COS * length
 
 
 def _chain(i, ends, at, used, seen):
@@ -159,23 +204,36 @@ def seam_patches(network: CurveNetwork, patches, holes_report=()):
         The updated hole entries.
     """
     patches = list(patches)
-    holes = {tuple(h) for p in patches for h in p.holes}
+    holes = {tuple(sorted(h)) for p in patches for h in p.holes}
     uses = np.zeros(network.number_of_edges, np.int64)
     for p in patches:
         np.add.at(uses, list(p.all_edges), 1)
     drop, faces = set(), []
-    for seam, a, b in seam_chains(network, patches):
-        gone = [k for k, p in enumerate(patches) if not p.holes and p.edges in (a, b)
-                and p.edges in holes and k not in drop]
-        after = uses.copy()
-        for k in gone:
-            np.add.at(after, list(patches[k].edges), -1)
-        np.add.at(after, list(a + b), 1)
-        if (after[list(a + b)] > 2).any():
-            continue
-        uses = after
-        drop |= set(gone)
-        faces.append((seam, a, b, len(gone)))
+    discs = {k: tuple(sorted(p.edges)) for k, p in enumerate(patches)
+             if not p.holes and len(set(p.edges)) == len(p.edges)}
+    added = True
+    while added:            # a seam face's loops can end the next seam (stacked walls)
+        added = False
+        current = [p for k, p in enumerate(patches) if k not in drop] + [
+            Patch(a + b + tuple(seam) * 2, "auto") for seam, a, b, _ in faces]
+        for seam, a, b in seam_chains(network, current):
+            on = [k for k, lp in discs.items() if k not in drop and lp in (a, b)]
+            gone = [k for k in on if discs[k] in holes]
+            after = uses.copy()
+            for k in gone:
+                np.add.at(after, list(patches[k].edges), -1)
+            np.add.at(after, list(a + b), 1)
+            # a disc between two walls would make its curves bound three patches
+            for k in on:
+                if k not in gone and (after[list(patches[k].edges)] > 2).any():
+                    np.add.at(after, list(patches[k].edges), -1)
+                    gone.append(k)
+            if (after[list(a + b)] > 2).any():
+                continue
+            uses = after
+            drop |= set(gone)
+            faces.append((seam, a, b, len(gone)))
+            added = True
     index = {}
     out = []
     for k, p in enumerate(patches):
@@ -187,12 +245,12 @@ def seam_patches(network: CurveNetwork, patches, holes_report=()):
         report.append({"face": len(out), "seam": list(seam), "loops": [list(a), list(b)],
                        "discs_dropped": n_gone})
         out.append(Patch(a + b + tuple(seam) * 2, "auto"))
-    gone_loops = {patches[k].edges for k in drop}
+    gone_loops = {tuple(sorted(patches[k].edges)) for k in drop}
     new_holes = []
     for h in holes_report:
         # a face with holes is never dropped (only discs are)
         h = dict(h, face=index[h["face"]])
-        if h["disc_kept"] and tuple(h["loop"]) in gone_loops:
+        if h["disc_kept"] and tuple(sorted(h["loop"])) in gone_loops:
             h["disc_kept"] = False
         new_holes.append(h)
     return out, report, new_holes

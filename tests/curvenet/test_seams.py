@@ -7,6 +7,7 @@ from curvenet.core.errors import NetworkError
 from curvenet.cycles import find_patches
 from curvenet.cycles.loops import cycle_to_loop, newell_normal, orient_boundaries, signed_volume
 from curvenet.cycles.seams import seam_chains
+from curvenet.model.network import CurveNetwork
 from curvenet.model.patchset import PatchSet
 
 from ._networks import bored_prism, seam_cylinder
@@ -131,3 +132,35 @@ def test_two_loops_side_by_side_on_a_stem_are_not_the_ends_of_a_tube():
     ps = find_patches(net)
     assert ps.report["seams"] == []
     assert sorted(len(p.edges) for p in ps.patches) == [2, 2]
+
+
+def _circle(r, z, n=33):
+    t = np.linspace(0, 2 * np.pi, n)
+    return np.c_[r * np.cos(t), r * np.sin(t), np.full(n, z)]
+
+
+def test_a_cone_to_its_apex_is_one_face_walking_its_seam_twice():
+    """A pointed cone: base circle, one seam line to the apex (a junction of that curve
+    only). The cone face is the circle and the seam twice; the base a disc."""
+    net = CurveNetwork(np.array([[1.0, 0, 0], [0.0, 0, 2]]))
+    net.add_edge(0, 0, _circle(1.0, 0.0))
+    net.add_edge(0, 1, np.linspace([1.0, 0, 0], [0.0, 0, 2], 9))
+    edges = sorted(tuple(sorted(p.edges)) for p in find_patches(net).patches)
+    assert edges == [(0,), (0, 1, 1)]
+
+
+def test_walls_stacked_on_one_axis_replace_the_discs_between_them():
+    """Cone, cylinder, cone along one axis (a chamfered bore, a shaft): three seam faces,
+    the two circles between walls lose their discs (a curve of three patches otherwise)."""
+    rz = [(1.0, 0.0), (1.2, 0.2), (1.2, 1.0), (1.0, 1.2)]
+    net = CurveNetwork(np.array([[r, 0, z] for r, z in rz]))
+    for k, (r, z) in enumerate(rz):
+        net.add_edge(k, k, _circle(r, z))
+    for k in range(3):
+        net.add_edge(k, k + 1, np.linspace(net.positions[k], net.positions[k + 1], 5))
+    ps = find_patches(net).patches
+    uses = np.zeros(net.number_of_edges, int)
+    for p in ps:
+        np.add.at(uses, list(set(p.all_edges)), 1)
+    walls = [p for p in ps if len(set(p.edges)) < len(p.edges)]
+    assert len(walls) == 3 and len(ps) == 5 and uses.max() <= 2
