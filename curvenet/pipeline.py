@@ -29,7 +29,7 @@ from .model.sketch import Sketch
 from .route import (AUTO_MIN_COVERAGE, Region, Route, RouteDecision, SurfaceInput,
                     SurfaceSettings, Surfacer, coverage, get_surfacer, region_route,
                     surfacer_names)
-from .route.check import judge_patches
+from .route.check import judge_patches, nonmanifold_curves, wall_area
 from .route.regions import plan_regions
 from .route.wires import stroke_wires
 
@@ -414,22 +414,6 @@ def _surface_route(plan: _Plan, decision: RouteDecision, settings: SurfaceSettin
     return res, name
 
 
-def _nonmanifold(ps) -> int:
-    """Curves of ``ps``'s network that bound three or more of its patches."""
-    uses = np.zeros(ps.network.number_of_edges, np.int64)
-    for p in ps.patches:
-        np.add.at(uses, list(p.all_edges), 1)
-    return int(np.count_nonzero(uses >= 3))
-
-
-def _area_share(res, patches) -> float:
-    """Share of the surface's area on the faces of ``patches`` (patch indices)."""
-    V, F = np.asarray(res.vertices), np.asarray(res.faces)
-    area = np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1)
-    total = float(area.sum())
-    return float(area[np.isin(res.face_patch, list(patches))].sum() / total) if total else 0.0
-
-
 #: Walls on less than this share of the classical surface's area are reported and kept:
 #: a sliver is not worth a neural fit that would lose strokes elsewhere.
 JUDGE_WALL_AREA = 0.01
@@ -473,7 +457,8 @@ def _judge(plan: _Plan, decision: RouteDecision, settings: SurfaceSettings, clos
     other = "faces" if mode == "basis" else "basis"
     alt = find_patches(net, close=close, mode=other)
     check["coverage"][other] = coverage(alt)[0]
-    better = not first["passes"] or _nonmanifold(alt) < first["nonmanifold"]
+    better = not first["passes"] or nonmanifold_curves(
+        [p.all_edges for p in alt.patches], net.number_of_edges) < first["nonmanifold"]
     if alt.patches and better and check["coverage"][other] >= diag["coverage"] - 1e-9:
         alt_res, alt_name = _surface_route(plan, decision, settings, sketch=sketch, net=net,
                                            ps=alt, timings=timings, diag=diag)
@@ -484,7 +469,7 @@ def _judge(plan: _Plan, decision: RouteDecision, settings: SurfaceSettings, clos
             check.update(taken=other, nonmanifold=verdict["nonmanifold"])
             diag["patches"] = len(alt.patches)
             return alt_res, alt, replace(decision, patches=len(alt.patches), check=check), alt_name
-    check["wall_area"] = _area_share(res, first["walls"])
+    check["wall_area"] = wall_area(res.vertices, res.faces, res.face_patch, first["walls"])
     if first["passes"] or check["wall_area"] < JUDGE_WALL_AREA:
         return res, ps, replace(decision, check=check), name
     strokes, labels = _strokes(sketch, net)

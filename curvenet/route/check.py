@@ -17,7 +17,7 @@ import numpy as np
 
 from ..core.geometry import face_normals_areas
 
-__all__ = ["WALL_WINDING", "CHECK_SAMPLES", "judge_patches"]
+__all__ = ["WALL_WINDING", "CHECK_SAMPLES", "judge_patches", "nonmanifold_curves", "wall_area"]
 
 #: A patch is a wall when the winding number just off it, averaged over its two sides,
 #: has a median magnitude above this (1 inside a closed shape, 1/2 on its boundary).
@@ -70,9 +70,7 @@ def judge_patches(vertices, faces, face_patch, patch_edges, n_curves: int, *,
     V = np.ascontiguousarray(vertices, np.float64)
     F = np.ascontiguousarray(faces, np.int64)
     face_patch = np.asarray(face_patch, np.int64)
-    uses = np.bincount(np.concatenate([np.asarray(p, np.int64) for p in patch_edges])
-                       if patch_edges else np.zeros(0, np.int64), minlength=n_curves)
-    out = {"walls": [], "winding": [], "nonmanifold": int(np.count_nonzero(uses >= 3)),
+    out = {"walls": [], "winding": [], "nonmanifold": nonmanifold_curves(patch_edges, n_curves),
            "passes": True}
     if not len(F):
         return out
@@ -98,3 +96,43 @@ def judge_patches(vertices, faces, face_patch, patch_edges, n_curves: int, *,
              if m > WALL_WINDING and not crease[np.asarray(patch_edges[k], np.int64)].all()]
     out.update(walls=walls, winding=winding, passes=not walls)
     return out
+
+
+def nonmanifold_curves(patch_edges, n_curves: int) -> int:
+    """Curves bounding three or more patches.
+
+    Parameters
+    ----------
+    patch_edges : list of sequence of int
+        Per patch its curve ids (``Patch.all_edges``: a seam walked twice counts twice).
+    n_curves : int
+
+    Returns
+    -------
+    int
+    """
+    uses = np.bincount(np.concatenate([np.asarray(p, np.int64) for p in patch_edges])
+                       if patch_edges else np.zeros(0, np.int64), minlength=n_curves)
+    return int(np.count_nonzero(uses >= 3))
+
+
+def wall_area(vertices, faces, face_patch, walls) -> float:
+    """Share of a surface's area on the faces of some patches.
+
+    Parameters
+    ----------
+    vertices : (V, 3) float64
+    faces : (F, 3) int64
+    face_patch : (F,) int64
+    walls : sequence of int
+        Patch indices (:func:`judge_patches`' ``walls``).
+
+    Returns
+    -------
+    float
+        In [0, 1]; 0 for an empty surface.
+    """
+    _, area = face_normals_areas(np.asarray(vertices, np.float64), np.asarray(faces, np.int64))
+    total = float(area.sum())
+    hit = np.isin(np.asarray(face_patch), np.asarray(list(walls), np.int64))
+    return float(area[hit].sum() / total) if total > 0 else 0.0
