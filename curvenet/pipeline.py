@@ -29,7 +29,7 @@ from .model.sketch import Sketch
 from .route import (AUTO_MIN_COVERAGE, Region, Route, RouteDecision, SurfaceInput,
                     SurfaceSettings, Surfacer, coverage, get_surfacer, region_route,
                     surfacer_names)
-from .route.check import judge_patches, nonmanifold_curves, wall_area
+from .route.check import judge_patches, wall_area
 from .route.regions import plan_regions
 from .route.wires import stroke_wires
 
@@ -427,12 +427,10 @@ def _judge(plan: _Plan, decision: RouteDecision, settings: SurfaceSettings, clos
     """``auto``'s check of the classical surface, and what it takes when the check fails.
 
     The surface passes when no patch is a wall inside the shape the others bound
-    (:func:`~curvenet.route.check.judge_patches`). When it does not, or when some of its
-    curves bound three or more patches and the other patch selection
-    (:func:`~curvenet.cycles.find_patches` ``mode="faces"`` or ``"basis"``) has fewer
-    such curves, that selection is surfaced and kept if it covers at least the curve
-    length the first covers, has no walls and fewer such curves (or the first has
-    walls). A surface whose walls hold at least :data:`JUDGE_WALL_AREA` of its area and
+    (:func:`~curvenet.route.check.judge_patches`). When it does not, the other patch
+    selection (:func:`~curvenet.cycles.find_patches` ``mode="faces"`` or ``"basis"``)
+    is surfaced and kept if it covers at least the curve length the first covers and
+    has no walls. A surface whose walls hold at least :data:`JUDGE_WALL_AREA` of its area and
     that has no such replacement goes to the neural route, which is kept if its
     stroke fidelity is at most :data:`JUDGE_FIDELITY_MARGIN` below the classical
     surface's; else the classical surface stays, walls and all (a wrong shape through
@@ -451,26 +449,23 @@ def _judge(plan: _Plan, decision: RouteDecision, settings: SurfaceSettings, clos
     mode = ps.report.get("mode", "basis")
     check = {"walls": {mode: len(first["walls"])}, "nonmanifold": first["nonmanifold"],
              "coverage": {mode: diag["coverage"]}, "taken": mode}
-    if first["passes"] and not first["nonmanifold"]:
+    if first["passes"]:
         return res, ps, replace(decision, check=check), name
     from .cycles.find import find_patches
     other = "faces" if mode == "basis" else "basis"
     alt = find_patches(net, close=close, mode=other)
     check["coverage"][other] = coverage(alt)[0]
-    better = not first["passes"] or nonmanifold_curves(
-        [p.all_edges for p in alt.patches], net.number_of_edges) < first["nonmanifold"]
-    if alt.patches and better and check["coverage"][other] >= diag["coverage"] - 1e-9:
+    if alt.patches and check["coverage"][other] >= diag["coverage"] - 1e-9:
         alt_res, alt_name = _surface_route(plan, decision, settings, sketch=sketch, net=net,
                                            ps=alt, timings=timings, diag=diag)
         verdict = judge(alt_res, alt)
         check["walls"][other] = len(verdict["walls"])
-        if verdict["passes"] and (not first["passes"]
-                                  or verdict["nonmanifold"] < first["nonmanifold"]):
+        if verdict["passes"]:
             check.update(taken=other, nonmanifold=verdict["nonmanifold"])
             diag["patches"] = len(alt.patches)
             return alt_res, alt, replace(decision, patches=len(alt.patches), check=check), alt_name
     check["wall_area"] = wall_area(res.vertices, res.faces, res.face_patch, first["walls"])
-    if first["passes"] or check["wall_area"] < JUDGE_WALL_AREA:
+    if check["wall_area"] < JUDGE_WALL_AREA:
         return res, ps, replace(decision, check=check), name
     strokes, labels = _strokes(sketch, net)
     neural = _run(plan.stroke, SurfaceInput(settings, strokes=strokes, labels=labels),
