@@ -66,7 +66,8 @@ def _through_paths(net):
     """The network's curves chained straight through its junctions: ``[[(edge, fwd)]]``.
 
     At a junction a path leaves along the curve whose tangent continues its own most
-    closely (a crossing of four curves continues to the opposite one).
+    closely (a crossing of four curves continues to the opposite one); it ends where it
+    began (a closed section) or where no unused curve leaves.
     """
     ends = [(e.u, e.v) for e in net.edges]
 
@@ -88,6 +89,8 @@ def _through_paths(net):
             used.add(i)
             path.append((i, fwd))
             v = ends[i][1] if fwd else ends[i][0]
+            if v == ends[i0][0]:          # back where it began: a closed section
+                break
             t = tangent(i, fwd, False)
             options = [(j, f) for j, f in at[v] if j not in used]
             if not options:
