@@ -41,13 +41,26 @@ def clean(poly, eps):
     """Drop interior points closer than ``eps`` to their predecessor; ends stay exact.
 
     Removes the needle segments that joins and cuts can leave (their direction is
-    noise and shows as a kink). A run of such points is dropped whole, which only
-    lengthens one segment.
+    noise and shows as a kink). A run of such points shorter than ``eps`` is dropped
+    whole, which only lengthens one segment; a longer run (a stroke sampled more
+    densely than ``eps``) keeps its first point past every ``eps`` of arc length from
+    the point before the run, so that its shape stays (dropped whole, a small circle
+    drawn densely would become its chord).
     """
     if len(poly) <= 2:
         return poly
+    poly = np.asarray(poly)
+    step = np.linalg.norm(np.diff(poly, axis=0), axis=1)
     keep = np.ones(len(poly), dtype=bool)
-    keep[1:-1] = np.linalg.norm(np.diff(poly[:-1], axis=0), axis=1) >= eps
+    keep[1:-1] = step[:-1] >= eps
+    cum = np.concatenate([[0.0], np.cumsum(step)])
+    anchor = np.maximum.accumulate(np.where(keep, np.arange(len(poly)), 0))
+    nxt = np.minimum.accumulate(np.where(keep, np.arange(len(poly)), len(poly) - 1)[::-1])[::-1]
+    since = cum - cum[anchor]
+    bins = np.floor(since / eps)
+    first = np.zeros(len(poly), dtype=bool)
+    first[1:] = (bins[1:] > bins[:-1]) & (anchor[1:] == anchor[:-1])
+    keep |= first & (cum[nxt] - cum >= eps)
     idx = np.flatnonzero(keep)
     if len(idx) > 2 and np.linalg.norm(poly[-1] - poly[idx[-2]]) < eps:
         keep[idx[-2]] = False

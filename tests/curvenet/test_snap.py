@@ -412,3 +412,16 @@ def test_strokes_that_cross_without_shared_points_are_snapped_with_a_tolerance()
     assert net.report["mode"] != "exact"
     assert net.number_of_vertices == 12 and net.number_of_edges == 24
     assert shape.network.number_of_edges == 24
+
+
+@pytest.mark.parametrize("samples", [300, 400, 2000])
+def test_a_small_loop_drawn_densely_keeps_its_shape(samples):
+    # a thin torus's meridian, one closed stroke across its two rings: its points lie
+    # closer together than the needle threshold; its two curves stay half circles
+    u = np.linspace(0, 2 * np.pi, 400)[:, None]
+    rings = [np.c_[a * np.cos(u), a * np.sin(u), 0 * u] for a in (0.75, 1.25)]
+    v = np.linspace(2.0, 2.0 + 2 * np.pi, samples)[:, None]
+    meridian = np.c_[1.0 + 0.25 * np.cos(v), 0 * v, 0.25 * np.sin(v)]
+    net = snap(Sketch(rings + [meridian], ["boundary"] * 3))
+    halves = sorted(e.length() for e in net.edges)[:2]
+    np.testing.assert_allclose(halves, 0.25 * np.pi, rtol=5e-3)
