@@ -18,7 +18,7 @@ from ..model.network import CurveNetwork
 from ..model.patchset import Patch
 
 __all__ = ["cycle_to_loop", "orient_patches", "orient_boundaries", "loop_points", "newell_normal",
-           "signed_volume"]
+           "signed_volume", "edge_components"]
 
 
 def cycle_to_loop(network: CurveNetwork, edge_ids) -> list:
@@ -123,7 +123,7 @@ def _seam_walk(network: CurveNetwork, ids: list) -> list:
     seam = sorted(e for e, c in count.items() if c == 2)
     rest = sorted(e for e, c in count.items() if c == 1)
     ends = {e: (network.edges[e].u, network.edges[e].v) for e in count}
-    groups = _components(rest, ends)
+    groups = edge_components(rest, ends)
     if not 1 <= len(groups) <= 2:
         raise NetworkError(f"cycle_to_loop: edges {sorted(ids)} are no seam face "
                            f"({len(groups)} loops beside the seam)")
@@ -159,8 +159,20 @@ def _seam_walk(network: CurveNetwork, ids: list) -> list:
     return walk + [(e, not f) for e, f in reversed(path)]
 
 
-def _components(edges, ends) -> list:
-    """Edge groups connected through shared junctions (sorted lists)."""
+def edge_components(edges, ends) -> list:
+    """Edge groups connected through shared junctions.
+
+    Parameters
+    ----------
+    edges : iterable of int
+    ends : sequence of (int, int)
+        End junctions of every edge id.
+
+    Returns
+    -------
+    list of list of int
+        Each group's edge ids, sorted; the groups sorted.
+    """
     parent = {e: e for e in edges}
 
     def root(e):

@@ -31,6 +31,7 @@ import numpy as np
 
 from ..model.network import CurveNetwork
 from ..model.patchset import Patch
+from .loops import edge_components
 
 __all__ = ["seam_patches", "seam_chains"]
 
@@ -44,23 +45,7 @@ def _loops_of(patch, ends) -> list:
     if max(counts.values(), default=1) < 2:
         return [tuple(sorted(lp)) for lp in (patch.edges, *patch.holes)]
     once = [e for e, c in counts.items() if c == 1]
-    parent = {e: e for e in once}
-
-    def root(e):
-        while parent[e] != e:
-            e = parent[e]
-        return e
-    by_vertex: dict = {}
-    for e in once:
-        for x in ends[e]:
-            if x in by_vertex:
-                parent[root(e)] = root(by_vertex[x])
-            else:
-                by_vertex[x] = e
-    groups: dict = {}
-    for e in once:
-        groups.setdefault(root(e), []).append(e)
-    return [tuple(sorted(g)) for g in groups.values()]
+    return [tuple(g) for g in edge_components(once, ends)]
 
 
 def seam_chains(network: CurveNetwork, patches) -> list:
