@@ -113,10 +113,12 @@ _FACING_COS = np.cos(np.radians(45.0))
 
 
 def _frame(network: CurveNetwork, loop):
-    """Arc-length weighted centre (3,) and unit normal (3,) of a loop's curve points."""
-    pts = np.concatenate([np.asarray(network.edges[e].curve, np.float64) for e in loop])
-    seg = np.linalg.norm(np.diff(pts, axis=0), axis=1)
-    w = np.r_[seg, 0.0] + np.r_[0.0, seg]
+    """Arc-length weighted centre (3,) and unit normal (3,) of a loop's curve points
+    (each point weighs half its two segments on its own curve)."""
+    curves = [np.asarray(network.edges[e].curve, np.float64) for e in loop]
+    pts = np.concatenate(curves)
+    seg = [np.linalg.norm(np.diff(c, axis=0), axis=1) for c in curves]
+    w = np.concatenate([np.r_[d, 0.0] + np.r_[0.0, d] for d in seg])
     w = w / w.sum() if w.sum() > 0 else np.full(len(pts), 1.0 / len(pts))
     centre = w @ pts
     _, _, vt = np.linalg.svd((pts - centre) * np.sqrt(w)[:, None], full_matrices=False)
