@@ -227,7 +227,45 @@ def _prepare(sketch, opts):
     return strokes, src, labels, diag, dropped
 
 
-def _crosses(strokes, diag) -> bool:
+class _Points:
+    """The strokes' points one after another, their KD-tree and (when first asked) the pairs
+    of points that coincide (within :data:`COINCIDENT_REL` of the diagonal): built once for
+    the exactness test, the crossing test and the exact graph."""
+
+    def __init__(self, strokes, diag):
+        self.counts = np.array([len(s) for s in strokes])
+        self.pts = np.concatenate(strokes)
+        self.sid = np.repeat(np.arange(len(strokes)), self.counts)
+        self.tree = cKDTree(self.pts)
+        self.eps = COINCIDENT_REL * diag
+        self._pairs = None
+
+    @property
+    def pairs(self):
+        """``(P, 2) int64``, ``i < j``: the coinciding point pairs."""
+        if self._pairs is None:
+            self._pairs = self.tree.query_pairs(self.eps, output_type="ndarray")
+        return self._pairs
+
+
+def _arc_to(pts, sid, marks):
+    """Arc length along its own stroke from each point to the nearest of ``marks`` (sorted
+    point indices) on that stroke, ``inf`` where the stroke has none: ``(n,) float64``,
+    never less than the straight distance to that mark."""
+    n = len(pts)
+    s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+    at = np.arange(n)
+    out = np.full(n, np.inf)
+    for k, sign in ((np.searchsorted(marks, at, side="right") - 1, 1.0),
+                    (np.searchsorted(marks, at, side="left"), -1.0)):
+        ok = (k >= 0) & (k < len(marks))
+        m = marks[np.clip(k, 0, len(marks) - 1)]
+        ok &= sid[m] == sid
+        out[ok] = np.minimum(out[ok], sign * (s[ok] - s[m[ok]]))
+    return out
+
+
+def _crosses(strokes, diag, points: _Points) -> bool:
     """Whether two strokes cross (pass within :data:`CROSSING_REL` of the diagonal of each
     other at an angle, away from the points they share): then they are drawn, not
     exported.
@@ -235,19 +273,29 @@ def _crosses(strokes, diag) -> bool:
     Sample pairs of different strokes within ``2 CROSSING_STEP`` of each other are tested
     where the first of the pair lies :data:`CROSSING_AWAY` or farther from every shared
     point; pairs are gathered only around such points, at most :data:`_CROSSING_CHUNK`
-    of them at a time, so the many pairs around junctions are never formed.
+    of them at a time, so the many pairs around junctions are never formed. A point
+    within ``CROSSING_AWAY`` of a shared point along its own stroke is near without a
+    search. ``points`` (of the same strokes) are reused when the sampling adds none.
     """
     eps = COINCIDENT_REL * diag
     step = CROSSING_STEP * diag
+    away = CROSSING_AWAY * diag
     pts, counts = densify_polylines(strokes, step)
     sid = np.repeat(np.arange(len(strokes)), counts)
     last = np.cumsum(counts) - 1
-    tree = cKDTree(pts)
-    shared = tree.query_pairs(eps, output_type="ndarray")
+    if len(points.pts) == len(pts):
+        tree, shared = points.tree, points.pairs
+    else:
+        tree = cKDTree(pts)
+        shared = tree.query_pairs(eps, output_type="ndarray")
     shared = shared[sid[shared[:, 0]] != sid[shared[:, 1]]]
     far = np.arange(len(pts))
     if len(shared):
-        far = np.flatnonzero(cKDTree(pts[shared[:, 0]]).query(pts)[0] >= CROSSING_AWAY * diag)
+        marks = np.unique(shared[:, 0])
+        far = np.flatnonzero(_arc_to(pts, sid, marks) >= away * (1 - 1e-9))
+        if len(far):
+            d = cKDTree(np.unique(pts[marks], axis=0)).query(pts[far])[0]
+            far = far[d >= away]
     cos_max = np.cos(np.radians(CROSSING_ANGLE))
     for lo in range(0, len(far), _CROSSING_CHUNK):
         ids = far[lo:lo + _CROSSING_CHUNK]
@@ -265,18 +313,14 @@ def _crosses(strokes, diag) -> bool:
     return False
 
 
-def _is_exact(strokes, diag):
+def _is_exact(strokes, diag, points: _Points):
     """Whether every stroke end coincides with a point of another stroke or its own end,
     and no two strokes cross elsewhere (:func:`_crosses`)."""
-    counts = np.array([len(s) for s in strokes])
-    pts = np.concatenate(strokes)
-    sid = np.repeat(np.arange(len(strokes)), counts)
+    pts, sid, counts, tree, eps = points.pts, points.sid, points.counts, points.tree, points.eps
     last = np.cumsum(counts) - 1
     first = last - counts + 1
-    eps = COINCIDENT_REL * diag
     closed = np.linalg.norm(pts[first] - pts[last], axis=1) <= eps
     ends = np.concatenate([first, last])
-    tree = cKDTree(pts)
     kq = min(8, len(pts))
     dist, nn = tree.query(pts[ends], k=kq, distance_upper_bound=eps)
     nn = nn.reshape(len(ends), kq)
@@ -288,14 +332,13 @@ def _is_exact(strokes, diag):
             near = tree.query_ball_point(pts[ends[q]], eps)
             attached[q] = bool(np.any(sid[near] != sid[ends[q]]))
     return bool(attached.all()) and (len(strokes) > 1 or bool(closed.all())) \
-        and not _crosses(strokes, diag)
+        and not _crosses(strokes, diag, points)
 
 
-def _snap_exact(strokes, src, labels, diag):
+def _snap_exact(strokes, src, labels, diag, points: _Points):
     """Graph of exactly coincident points (no tolerance); see module docstring."""
-    pts = np.concatenate(strokes)
-    eps = COINCIDENT_REL * diag
-    ids = components(len(pts), cKDTree(pts).query_pairs(eps, output_type="ndarray"))
+    pts = points.pts
+    ids = components(len(pts), points.pairs)
     verts = pts[first_items(ids)]  # each group at its first point
     offs = np.cumsum([0] + [len(s) for s in strokes])
     polys = [ids[offs[k]:offs[k + 1]] for k in range(len(strokes))]
@@ -402,12 +445,13 @@ def snap(sketch: Sketch, *, snap_tol: float | str | None = "auto", corner_angle:
     if not strokes:
         raise InvalidParameterError("no stroke has two distinct points")
     mode = opts.mode
+    points = _Points(strokes, diag) if mode in ("auto", "exact") else None
     if mode == "auto":
-        mode = "exact" if _is_exact(strokes, diag) else "rough"
+        mode = "exact" if _is_exact(strokes, diag, points) else "rough"
     if mode == "exact":
         why = "exact: every stroke end coincides with another stroke (no tolerance)"
         opts = replace(opts, snap_tol=0.0 if opts.snap_tol == "auto" else opts.snap_tol)
-        net = _snap_exact(strokes, src, labels, diag)
+        net = _snap_exact(strokes, src, labels, diag, points)
         net.report.update(_common_report(net, diag, opts, len(strokes), dropped, why))
         return net
     if opts.snap_tol == "auto":

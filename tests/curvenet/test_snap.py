@@ -425,3 +425,21 @@ def test_a_small_loop_drawn_densely_keeps_its_shape(samples):
     net = snap(Sketch(rings + [meridian], ["boundary"] * 3))
     halves = sorted(e.length() for e in net.edges)[:2]
     np.testing.assert_allclose(halves, 0.25 * np.pi, rtol=5e-3)
+
+
+def test_arc_to_marks_is_the_along_stroke_distance_and_bounds_the_straight_one():
+    from curvenet.snap.graph import _arc_to
+    rng = np.random.default_rng(3)
+    strokes = [np.cumsum(rng.normal(size=(n, 3)), axis=0) for n in (7, 1, 12, 5)]
+    pts = np.concatenate(strokes)
+    sid = np.repeat(np.arange(4), [len(s) for s in strokes])
+    marks = np.array([2, 8, 9, 15])                     # none on the last stroke
+    got = _arc_to(pts, sid, marks)
+    arc = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+    for i in range(len(pts)):
+        own = [m for m in marks if sid[m] == sid[i]]
+        want = min((abs(arc[i] - arc[m]) for m in own), default=np.inf)
+        assert got[i] == pytest.approx(want)
+        if own:
+            assert got[i] >= min(np.linalg.norm(pts[i] - pts[m]) for m in own) - 1e-12
+    assert np.isinf(got[sid == 3]).all()
