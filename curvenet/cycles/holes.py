@@ -241,9 +241,9 @@ def _inside(planes: _Planes, i, j):
 
     One point-in-polygon call per outer patch, on all its candidates' points.
     """
-    from matplotlib.path import Path
     if len(i) == 0:
         return i, j
+    from matplotlib.path import Path
     keep = np.zeros(len(i), bool)
     order = np.argsort(j, kind="stable")
     bounds = np.flatnonzero(np.r_[True, j[order][1:] != j[order][:-1], True])

@@ -30,12 +30,12 @@ __all__ = ["read_patches", "write_patches", "read_network", "write_network"]
 
 def write_network(path, network: CurveNetwork) -> None:
     """Write ``NETWORK.json`` atomically."""
-    atomic_write_text(path, json.dumps(network.to_dict()))
+    atomic_write_text(path, json.dumps(network.to_dict(), check_circular=False))
 
 
 def write_patches(path, patchset: PatchSet) -> None:
     """Write ``PATCHES.json`` atomically."""
-    atomic_write_text(path, json.dumps(patchset.to_dict()))
+    atomic_write_text(path, json.dumps(patchset.to_dict(), check_circular=False))
 
 
 def read_patches(path) -> PatchSet:

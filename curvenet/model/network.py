@@ -2,20 +2,23 @@
 
 Edges are stored in a list, so an edge's index is stable and is the id used by
 patch sets and ``PATCHES.json``. A networkx ``MultiGraph`` view (edge key = edge
-index) is built on demand for graph algorithms.
+index) is built on demand for graph algorithms (networkx is imported only then).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
-import networkx as nx
 import numpy as np
 
 from ..core.geometry import arc_length, as_polyline
 from ..core.strokes import LABELS
 from ..core.errors import InvalidParameterError, NetworkError, SketchFormatError
 from .sketch import label_counts
+
+if TYPE_CHECKING:
+    import networkx as nx
 
 __all__ = ["Edge", "CurveNetwork", "indexed_network"]
 
@@ -130,6 +133,7 @@ class CurveNetwork:
 
     def graph(self) -> nx.MultiGraph:
         """networkx view: nodes ``0..V-1`` with ``pos``; edge key = edge id, data ``curve``."""
+        import networkx as nx
         g = nx.MultiGraph()
         g.add_nodes_from((i, {"pos": p}) for i, p in enumerate(self.positions))
         g.add_edges_from((e.u, e.v, i, {"curve": e.curve, "label": e.label})
@@ -138,7 +142,11 @@ class CurveNetwork:
 
     def number_of_components(self) -> int:
         """Connected components of the graph (isolated vertices count)."""
-        return nx.number_connected_components(self.graph())
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import connected_components
+        n, ends = self.number_of_vertices, self.endpoints
+        graph = coo_matrix((np.ones(len(ends)), (ends[:, 0], ends[:, 1])), shape=(n, n))
+        return int(connected_components(graph, directed=False)[0])
 
     def cycle_rank(self) -> int:
         """Dimension of the GF(2) cycle space, ``E - V + C``."""
@@ -227,18 +235,21 @@ def indexed_network(verts, polys, labels, sources) -> CurveNetwork:
     (4, 3)
     """
     nv = len(verts)
-    use = np.zeros(nv, dtype=np.int64)
     key = np.zeros(nv, dtype=bool)
-    seg_deg = np.zeros(nv, dtype=np.int64)
-    for p in polys:
-        closed = p[0] == p[-1] and len(p) > 2
-        body = p[:-1] if closed else p
-        np.add.at(use, body, 1)
-        np.add.at(seg_deg, p[:-1], 1)
-        np.add.at(seg_deg, p[1:], 1)
-        if not closed:
-            key[p[0]] = key[p[-1]] = True
-    key |= (use >= 2) | (seg_deg >= 3)
+    if polys:
+        sizes = np.array([len(p) for p in polys], np.int64)
+        flat = np.concatenate(polys).astype(np.int64)
+        last = np.cumsum(sizes) - 1
+        first = last - sizes + 1
+        closed = (flat[first] == flat[last]) & (sizes > 2)
+        body, not_first, not_last = (np.ones(len(flat), bool) for _ in range(3))
+        body[last[closed]] = False                   # a closed polyline's end counted once
+        not_first[first], not_last[last] = False, False
+        use = np.bincount(flat[body], minlength=nv)
+        seg_deg = (np.bincount(flat[not_last], minlength=nv)
+                   + np.bincount(flat[not_first], minlength=nv))
+        key[flat[first[~closed]]] = key[flat[last[~closed]]] = True
+        key |= (use >= 2) | (seg_deg >= 3)
     vid = -np.ones(nv, dtype=np.int64)
     net_v = list(np.flatnonzero(key))
     vid[net_v] = np.arange(len(net_v))

@@ -216,8 +216,7 @@ def _prepare(sketch, opts):
         raise InvalidParameterError("sketch has zero extent (all points coincide)")
     strokes, src, labels = [], [], []
     dropped = 0
-    for i in use:
-        s = dedup(sketch.strokes[i], DUPLICATE_POINT_REL * diag)
+    for i, s in zip(use, dedup([sketch.strokes[i] for i in use], DUPLICATE_POINT_REL * diag)):
         if len(s) < 2:
             dropped += 1
             continue

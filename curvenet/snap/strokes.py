@@ -24,17 +24,25 @@ LOOP_OVERLAP = 0.15
 
 
 # --------------------------------------------------------------------------- small tools
-def dedup(poly, eps):
-    """Drop points within ``eps`` of their predecessor (the last point is kept)."""
-    poly = np.asarray(poly, dtype=np.float64)
-    if len(poly) < 2:
-        return poly
-    d = np.linalg.norm(np.diff(poly, axis=0), axis=1)
-    keep = np.concatenate([[True], d > eps])
-    out = poly[keep]
-    if not keep[-1] and len(out) > 1:
-        out[-1] = poly[-1]
-    return out
+def dedup(polys, eps) -> list:
+    """Each polyline without the points within ``eps`` of their predecessor (its last point
+    is kept, in place of the last one kept if need be); polylines of under two points as
+    they are. ``polys``: list of ``(n_k, 3)``; returns a list of ``(m_k, 3) float64``,
+    every polyline's at once."""
+    sizes = np.array([len(p) for p in polys], np.int64)
+    pts = np.concatenate([np.asarray(p, dtype=np.float64).reshape(-1, 3) for p in polys])
+    keep = np.ones(len(pts), bool)
+    keep[1:] = np.linalg.norm(np.diff(pts, axis=0), axis=1) > eps
+    first = np.cumsum(sizes) - sizes
+    keep[first[sizes > 0]] = True
+    out = pts[keep]
+    kept = np.add.reduceat(keep, first[sizes > 0]) if len(pts) else np.zeros(0, np.int64)
+    counts = np.zeros(len(polys), np.int64)
+    counts[sizes > 0] = kept
+    last = first + sizes - 1
+    fix = (sizes >= 2) & ~keep[np.maximum(last, 0)] & (counts > 1)
+    out[(np.cumsum(counts) - 1)[fix]] = pts[last[fix]]
+    return np.split(out, np.cumsum(counts)[:-1])
 
 
 def clean(poly, eps):
