@@ -16,35 +16,64 @@ from ..core.errors import SketchFormatError
 __all__ = ["parse_obj", "parse_obj_slow", "chain_segments", "read_obj"]
 
 
+#: Characters that :meth:`str.splitlines` breaks lines at, besides ``\n`` and ``\r\n``
+#: (ASCII ones; a text with any of them, or with non-ASCII characters, takes the
+#: token-by-token parser).
+_OTHER_BREAKS = "\r\x0b\x0c\x1c\x1d\x1e"
+
+
+def _line_kinds(text):
+    """The text's bytes, each line ended by ``\n``, and per line its start offset, its
+    length with the ``\n`` and its first two characters, for an ASCII text whose only line
+    break is ``\n``: ``(b, start, span, c0, c1)``, uint8 bytes and codes (0 past a line's
+    end), int64 offsets, one per :meth:`str.splitlines` line."""
+    b = np.frombuffer((text if text.endswith("\n") or not text else text + "\n")
+                      .encode("ascii"), np.uint8)
+    nl = np.flatnonzero(b == 10)
+    start = np.concatenate([[0], nl[:-1] + 1]).astype(np.int64)
+    span = nl + 1 - start
+    c0 = np.where(span > 1, b[start], 0)                 # every line ends in b: in range
+    c1 = np.where(span > 2, b[np.minimum(start + 1, len(b) - 1)], 0)
+    return b, start, span, c0, c1
+
+
+def _bodies(b, start, span, lines, sep):
+    """The text of ``lines`` (line numbers) after their first two characters, each followed
+    by ``sep``."""
+    chosen = np.zeros(len(start), bool)
+    chosen[lines] = True
+    keep = np.repeat(chosen, span)
+    keep[start[lines]] = keep[start[lines] + 1] = False
+    return b[keep].tobytes().decode("ascii").replace("\n", sep)
+
+
 def parse_obj(text, path):
     """Parse OBJ text into vertices and polylines (fast path, slow path on any anomaly).
 
-    The fast path handles the common layout (``v x y z`` and ``l i j ...`` records
-    starting in column 0, integer or ``i/t`` indices) with two C-level
-    ``numpy.fromstring`` calls; anything else (extra vertex columns, tabs, a bad
-    token, index 0) falls back to :func:`parse_obj_slow`, which also produces
-    the error messages with line numbers.
+    The fast path handles the common layout (ASCII, ``\n`` or ``\r\n`` line ends,
+    ``v x y z`` and ``l i j ...`` records starting in column 0, integer or ``i/t``
+    indices): the lines are told apart from their first two bytes, all at once, and
+    read with two C-level ``numpy.fromstring`` calls; anything else (extra vertex
+    columns, tabs, an indented record, a bad token, index 0) falls back to
+    :func:`parse_obj_slow`, which also produces the error messages with line numbers.
     """
-    lines = text.splitlines()
-    v_idx, l_idx, g_idx = [], [], []
-    for i, ln in enumerate(lines):
-        c = ln[:2]
-        if c == "v ":
-            v_idx.append(i)
-        elif c == "l ":
-            l_idx.append(i)
-        elif c in ("g ", "o ", "g", "o"):
-            g_idx.append(i)
-        elif ln and ln[0] not in "#vf" and ln.strip() and not ln.lstrip().startswith("#"):
-            if ln.split()[0] in ("v", "l", "g", "o"):
-                return parse_obj_slow(text, path)
-        elif c in ("v\t", "l\t"):
-            return parse_obj_slow(text, path)
-    if not v_idx or not l_idx:
+    if "\r" in text:
+        text = text.replace("\r\n", "\n")
+    if not text.strip() or not text.isascii() or any(c in text for c in _OTHER_BREAKS):
+        return parse_obj_slow(text, path)
+    b, start, span, c0, c1 = _line_kinds(text)
+    sp, tab = ord(" "), ord("\t")
+    first = np.frombuffer(b"vlgo", np.uint8)
+    if ((c0 == sp) | (c0 == tab)).any() or (np.isin(c0, first) & (c1 == tab)).any():
+        return parse_obj_slow(text, path)             # an indented record or a tab after one
+    v_idx = np.flatnonzero((c0 == ord("v")) & (c1 == sp))
+    l_idx = np.flatnonzero((c0 == ord("l")) & (c1 == sp))
+    g_idx = np.flatnonzero(np.isin(c0, first[2:]) & ((c1 == sp) | (c1 == 0)))
+    if not len(v_idx) or not len(l_idx):
         return parse_obj_slow(text, path)
     try:
-        verts = np.fromstring("\n".join([lines[i][2:] for i in v_idx]), sep=" ")
-        ltext = " 0 ".join([lines[i][2:] for i in l_idx]) + " 0"
+        verts = np.fromstring(_bodies(b, start, span, v_idx, "\n"), sep=" ")
+        ltext = _bodies(b, start, span, l_idx, " 0 ")
         if "/" in ltext:
             ltext = re.sub(r"/\S*", "", ltext)
         flat = np.fromstring(ltext, sep=" ", dtype=np.int64)
@@ -60,18 +89,18 @@ def parse_obj(text, path):
         return parse_obj_slow(text, path)
     idx = flat[flat != 0]
     owner = np.repeat(np.arange(len(l_idx)), counts)
-    nv_at = np.searchsorted(np.asarray(v_idx), np.asarray(l_idx))[owner]
+    nv_at = np.searchsorted(v_idx, l_idx)[owner]
     idx = np.where(idx < 0, nv_at + idx, idx - 1)
     if ((idx < 0) | (idx >= nv_at)).any():
         return parse_obj_slow(text, path)
     labels_at = ["boundary"]
-    for i in g_idx:
-        lab = label_of(lines[i].split()[1:])
+    for a, n in zip(start[g_idx].tolist(), span[g_idx].tolist()):
+        lab = label_of(text[a:a + n].split()[1:])
         labels_at.append(lab if lab is not None else "boundary")
-    which = np.searchsorted(np.asarray(g_idx, dtype=np.int64), np.asarray(l_idx))
+    which = np.searchsorted(g_idx, l_idx)
     polys = np.split(idx, np.cumsum(counts)[:-1])
     return (verts.reshape(-1, 3), polys, [labels_at[w] for w in which.tolist()],
-            [i + 1 for i in l_idx])
+            (l_idx + 1).tolist())
 
 
 def parse_obj_slow(text, path):

@@ -153,13 +153,20 @@ def test_obj_fast_path_matches_token_parser(data_dir, tmp_path):
              + sorted((data_dir / "sketches" / "vns").rglob("*.obj")))
     odd = tmp_path / "odd.obj"  # layouts that take the slow path: w column, indent, tabs
     odd.write_text("v 0 0 0 1\n  v 1 0 0\nv\t2 0 0\n\tl 1 2 3\ng crease\nl 3/1/1 -2\n")
-    for f in files + [odd]:
-        text = f.read_text()
-        fast, slow = _io_obj.parse_obj(text, f), _io_obj.parse_obj_slow(text, f)
+    texts = [f.read_text() for f in files + [odd]] + [
+        # the fast path's own cases: CRLF, no final newline, non-ASCII, lone g, empty
+        "v 0 0 0\r\nv 1 0 0\r\nv 1 1 0\r\ng crease\r\nl 1 2 3\r\n",
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\ng\nl 1 2\no crease_2\nl -2 -1",
+        "# Fl\u00fcgel\nv 0 0 0\nv 1 0 0\ng crease\nl 1 2\n",
+        "v 0 0 0\n\nv 1 0 0\nvt 0 1\n# l 9 9\nl 1 2\n"]
+    for text in texts:
+        fast, slow = _io_obj.parse_obj(text, odd), _io_obj.parse_obj_slow(text, odd)
         np.testing.assert_array_equal(fast[0], slow[0])
         assert len(fast[1]) == len(slow[1])
         assert all(np.array_equal(a, b) for a, b in zip(fast[1], slow[1]))
         assert fast[2:] == slow[2:]
+    with pytest.raises(SketchFormatError):
+        _io_obj.parse_obj("\n", odd)
     sk = read_sketch(odd)
     assert sk.labels == ["boundary", "crease"]
     np.testing.assert_array_equal(sk.strokes[1], [[2, 0, 0], [1, 0, 0]])
