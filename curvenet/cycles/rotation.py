@@ -36,7 +36,7 @@ from itertools import permutations
 
 import numpy as np
 from scipy.sparse import coo_matrix
-from scipy.sparse.csgraph import breadth_first_order, connected_components, minimum_spanning_tree
+from scipy.sparse.csgraph import connected_components
 
 from ..core.polylines import Polylines, row_norms
 from ..core.tolerances import DIVISION_GUARD
@@ -295,6 +295,33 @@ class _Junctions:
     around: dict             # junction -> its half-edges
     options: dict            # junction -> candidate orders (:func:`_orders`), of half-edges
     transport: np.ndarray    # (C, 3, 3) per chain (:func:`_transports`)
+    votes: "_Votes"          # the chains between two junctions (:func:`_votes`)
+
+
+@dataclass
+class _Votes:
+    """The chains that join two different junctions, as :func:`_orient` weighs them."""
+
+    at: np.ndarray           # (N,) node index of each junction of ``options``, in its order
+    transport: np.ndarray    # (P, 3, 3) of each such chain
+    ia: np.ndarray           # (P,) node index of its first junction
+    ib: np.ndarray           # (P,) ... and of its last
+    group: np.ndarray        # (P,) one id per pair of junctions, in order of first chain
+    key: np.ndarray          # (G,) sorted ``min * N + max`` of the pairs' node indices
+    key_group: np.ndarray    # (G,) the group of each key
+
+
+def _votes(nodes, chains, transport, options) -> _Votes:
+    index = {int(v): i for i, v in enumerate(nodes)}
+    at = np.array([index[v] for v in options], np.int64)
+    pairs = [(k, index[a], index[b]) for k, (a, b, _) in enumerate(chains) if a != b]
+    k, ia, ib = (np.array(x, np.int64).reshape(-1) for x in (zip(*pairs) if pairs
+                                                             else ([], [], [])))
+    code = np.minimum(ia, ib) * len(nodes) + np.maximum(ia, ib)
+    key, first, group = np.unique(code, return_index=True, return_inverse=True)
+    rank = np.empty(len(key), np.int64)
+    rank[np.argsort(first, kind="stable")] = np.arange(len(key))
+    return _Votes(at, transport[k], ia, ib, rank[group.reshape(-1)], key, rank)
 
 
 def _junctions(network: CurveNetwork, alive: np.ndarray) -> _Junctions:
@@ -312,7 +339,9 @@ def _junctions(network: CurveNetwork, alive: np.ndarray) -> _Junctions:
     for h, v in enumerate(origin.tolist()):
         around.setdefault(v, []).append(h)
     options = _all_orders(around, tangents)
-    return _Junctions(nodes, chains, origin, around, options, _transports(lines))
+    transport = _transports(lines)
+    return _Junctions(nodes, chains, origin, around, options, transport,
+                      _votes(nodes, chains, transport, options))
 
 
 # --------------------------------------------------------------------------- faces
@@ -375,13 +404,16 @@ def embedded_faces(network: CurveNetwork) -> EmbeddedFaces:
 def _embed(network: CurveNetwork, J: _Junctions, choice: dict):
     """Faces of the rotation system with order ``choice[v]`` at junction ``v``:
     ``(loops, simple, conflicts)`` (see :func:`_orient`, :func:`_trace`)."""
-    order = {v: J.options[v][choice[v]] for v in J.options}
-    sign, conflicts = _orient(J, {v: o[1] for v, o in order.items()},
-                              {v: o[2] for v, o in order.items()})
+    order = [J.options[v][choice[v]] for v in J.options]
+    normal = np.empty((len(J.nodes), 3))
+    strength = np.empty(len(J.nodes))
+    normal[J.votes.at] = [o[1] for o in order]
+    strength[J.votes.at] = [o[2] for o in order]
+    sign, conflicts = _orient(J, normal, strength)
     succ = np.empty(len(J.origin), np.int64)
-    for v, (hs, _, _) in order.items():
-        hs = hs if sign[v] > 0 else hs[::-1]
-        succ[hs] = np.roll(hs, -1)
+    for (hs, _, _), positive in zip(order, (sign[J.votes.at] > 0).tolist()):
+        hs = hs if positive else hs[::-1]
+        succ[hs] = hs[1:] + hs[:1]
     loops, simple = _trace(network, J.chains, succ)
     return loops, simple, conflicts
 
@@ -397,56 +429,83 @@ def _badness(loops, simple, conflicts) -> tuple:
     return (sum(len(lp) for lp, ok in zip(loops, simple) if not ok), conflicts)
 
 
-def _orient(J: _Junctions, normal: dict, strength: dict):
+def _orient(J: _Junctions, normal: np.ndarray, strength: np.ndarray):
     """+-1 per junction (the side of its normal that agrees with its neighbours), and the
     number of conflicts: chains of weight over 0.1 whose vote the signs overrule.
 
-    A chain ``a -> b`` votes ``sign(n_b . T n_a)`` (``T`` its transport), weighed by the
+    ``normal`` ``(N, 3)`` and ``strength`` ``(N,)`` are the junctions' (node order). A
+    chain ``a -> b`` votes ``sign(n_b . T n_a)`` (``T`` its transport), weighed by the
     cosine's magnitude and the junctions' smaller strength; the signs follow a maximum
-    spanning tree of those weights.
+    spanning tree of the strongest vote between each two junctions (the first of equals).
+    Returns ``(sign, conflicts)``, ``sign`` ``(N,) int64``.
     """
-    nodes = J.nodes
-    pairs = [(k, a, b) for k, (a, b, _) in enumerate(J.chains) if a != b]
-    sign = {int(v): 1 for v in nodes}
-    if not pairs:
-        return sign, 0
-    k, a, b = (np.array(x, np.int64) for x in zip(*pairs))
-    carried = np.einsum("cij,cj->ci", J.transport[k], np.array([normal[int(x)] for x in a]))
-    carried /= np.maximum(np.linalg.norm(carried, axis=1, keepdims=True), DIVISION_GUARD)
-    dot = np.einsum("ij,ij->i", carried, np.array([normal[int(x)] for x in b]))
-    weight = np.abs(dot) * np.array([min(strength[int(x)], strength[int(y)])
-                                     for x, y in zip(a, b)])
-    index = {int(v): i for i, v in enumerate(nodes)}
-    ia, ib = np.array([index[int(x)] for x in a]), np.array([index[int(x)] for x in b])
-    lo, hi = np.minimum(ia, ib), np.maximum(ia, ib)
-    n = len(nodes)
-    best: dict = {}          # strongest vote per junction pair
-    for j, key in enumerate(zip(lo.tolist(), hi.tolist())):
-        if key not in best or weight[j] > weight[best[key]]:
-            best[key] = j
-    js = np.array(list(best.values()), np.int64)
-    tree = minimum_spanning_tree(coo_matrix((2.0 - weight[js], (lo[js], hi[js])),
-                                            shape=(n, n)).tocsr())
-    tree = tree + tree.T
-    flip = {}
-    for j in js:
-        flip[(int(ia[j]), int(ib[j]))] = flip[(int(ib[j]), int(ia[j]))] = dot[j] < 0
+    V, n = J.votes, len(J.nodes)
     s = np.ones(n + 1, np.int64)
-    _, comp = connected_components(tree, directed=False)
-    # one search from a root joined to the first junction of every component
-    roots = np.unique(comp, return_index=True)[1]
-    t, hub = tree.tocoo(), np.full(len(roots), n)
-    joined = coo_matrix((np.r_[t.data, np.ones(2 * len(roots))],
-                         (np.r_[t.row, hub, roots], np.r_[t.col, roots, hub])),
-                        shape=(n + 1, n + 1)).tocsr()
-    seq, pred = breadth_first_order(joined, n, directed=False)
-    first = set(roots.tolist())
-    for x, px in zip(seq[1:].tolist(), pred[seq[1:]].tolist()):
-        if x not in first:
-            s[x] = s[px] * (-1 if flip[(px, x)] else 1)
+    if len(V.ia) == 0:
+        return s[:n], 0
+    ia, ib = V.ia, V.ib
+    carried = np.einsum("cij,cj->ci", V.transport, normal[ia])
+    carried /= np.maximum(np.linalg.norm(carried, axis=1, keepdims=True), DIVISION_GUARD)
+    dot = np.einsum("ij,ij->i", carried, normal[ib])
+    weight = np.abs(dot) * np.minimum(strength[ia], strength[ib])
+    by = np.lexsort((np.arange(len(weight)), -weight, V.group))
+    best = np.empty(len(V.key), np.int64)
+    best[V.group[by[::-1]]] = by[::-1]             # the first of each group's best wins
+    lo, hi = np.minimum(ia[best], ib[best]), np.maximum(ia[best], ib[best])
+    r, c = _spanning_tree(lo, hi, 2.0 - weight[best], n)
+    code = r * n + c
+    flip = (dot[best[V.key_group[np.searchsorted(V.key, code)]]] < 0).tolist()
+    nbrs: list = [[] for _ in range(n)]
+    for x, y, f in zip(r.tolist(), c.tolist(), flip):
+        nbrs[x].append((y, f))
+        nbrs[y].append((x, f))
+    # each component from its first junction (sign +1), along the tree
+    seen = [False] * n
+    for root in range(n):
+        if seen[root]:
+            continue
+        seen[root] = True
+        stack = [root]
+        while stack:
+            x = stack.pop()
+            for y, f in nbrs[x]:
+                if not seen[y]:
+                    seen[y] = True
+                    s[y] = -s[x] if f else s[x]
+                    stack.append(y)
     s = s[:n]
     conflicts = int(np.count_nonzero((s[ia] * s[ib] * np.sign(dot) < 0) & (weight > 0.1)))
-    return {int(v): int(s[i]) for i, v in enumerate(nodes)}, conflicts
+    return s, conflicts
+
+
+def _spanning_tree(lo, hi, cost, n: int):
+    """Minimum spanning forest of the graph on ``n`` nodes with edges ``lo < hi`` (unique
+    pairs) of ``cost`` (positive): ``(lo, hi)`` of its edges.
+
+    Kruskal's algorithm as :func:`scipy.sparse.csgraph.minimum_spanning_tree` runs it (the
+    edges in row-major order, then stably sorted by cost), so the same forest where costs
+    tie; without building sparse matrices, which costs more than the search on the few
+    junctions of a network.
+    """
+    rows = np.argsort(lo * n + hi)
+    lo, hi, cost = lo[rows], hi[rows], cost[rows]
+    parent = list(range(n))
+
+    def root(x):
+        while parent[x] != x:
+            parent[x] = parent[parent[x]]
+            x = parent[x]
+        return x
+
+    kept = []
+    order = np.argsort(cost, kind="stable")
+    for j, a, b in zip(order.tolist(), lo[order].tolist(), hi[order].tolist()):
+        ra, rb = root(a), root(b)
+        if ra != rb:
+            parent[ra] = rb
+            kept.append(j)
+    kept = np.array(kept, np.int64)
+    return lo[kept], hi[kept]
 
 
 def _trace(network: CurveNetwork, chains, succ: np.ndarray):

@@ -102,3 +102,23 @@ def test_section_wireframes_embed_with_their_genus(shape, genus):
     assert d.max() < 5e-3 * net.diagonal
     deg = np.bincount(net.endpoints.ravel(), minlength=net.number_of_vertices)
     assert (deg == 4).all()
+
+
+def test_spanning_tree_is_scipys_forest_also_where_costs_tie():
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import minimum_spanning_tree
+    from curvenet.cycles.rotation import _spanning_tree
+    rng = np.random.default_rng(5)
+    for _ in range(200):
+        n = int(rng.integers(2, 30))
+        a, b = rng.integers(0, n, (2, int(rng.integers(1, 3 * n))))
+        code = np.unique(np.minimum(a, b) * n + np.maximum(a, b))
+        lo, hi = code // n, code % n
+        keep = lo < hi
+        lo, hi = lo[keep], hi[keep]
+        perm = rng.permutation(len(lo))                      # any input order
+        lo, hi = lo[perm], hi[perm]
+        cost = 1.0 + rng.integers(0, 3, len(lo)) / 4         # many ties
+        r, c = _spanning_tree(lo, hi, cost, n)
+        t = minimum_spanning_tree(coo_matrix((cost, (lo, hi)), shape=(n, n)).tocsr()).tocoo()
+        assert sorted(zip(r.tolist(), c.tolist())) == sorted(zip(t.row.tolist(), t.col.tolist()))
