@@ -68,8 +68,10 @@ def seam_report(pieces: list, border: list, net: ControlNet) -> list:
     pid, vid, u, v, err, corner = (np.concatenate(x) for x in zip(*border))
     P = np.empty((len(pid), 3))
     Nrm = np.empty((len(pid), 3))
+    by = np.argsort(pid, kind="stable")
+    at = np.searchsorted(pid[by], np.arange(len(pieces) + 1))
     for k, piece in enumerate(pieces):
-        m = pid == k
+        m = by[at[k]:at[k + 1]]
         P[m], Nrm[m] = _normals(piece, u[m], v[m])
     order = np.lexsort((pid, vid))
     pid, vid, P, Nrm, err = pid[order], vid[order], P[order], Nrm[order], err[order]
@@ -107,8 +109,10 @@ def seam_report(pieces: list, border: list, net: ControlNet) -> list:
         for e in c:
             n_sides[e] = n_sides.get(e, 0) + 1
     out = []
+    by = np.argsort(inv, kind="stable")                  # each pair's samples, in a slice
+    at = np.r_[0, np.cumsum(cnt)]
     for g in np.flatnonzero(cnt > 1):                  # a shared point is not a seam
-        m = inv == g
+        m = by[at[g]:at[g + 1]]
         a, b = (int(x) for x in uk[g])
         shared = curves[a].keys() & curves[b].keys()
         flipped = bool(np.nanmean(cos[m]) < 0) if np.isfinite(cos[m]).any() else False

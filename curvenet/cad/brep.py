@@ -30,7 +30,7 @@ from ..core.errors import CurvenetError
 from .occ import free_edge_count, heal, is_valid, occ_faces
 
 __all__ = ["CadInputError", "CadModel", "brep_shape", "curve_edges", "analytic_face",
-           "build_solids", "face_kinds", "manifold_groups", "EDGE_TOL", "LINE_TOL",
+           "build_solids", "solid_volumes", "face_kinds", "manifold_groups", "EDGE_TOL", "LINE_TOL",
            "SEW_TOL", "CAD_KINDS"]
 
 #: Largest distance of a curve's samples to its B-spline edge, fraction of the diagonal.
@@ -355,8 +355,8 @@ def build_solids(faces, groups, tolerance: float):
     shape : TopoDS_Compound
         The solids and the open shells (a lone face as it is).
     report : dict
-        ``sewing_free_edges`` (edges bounding one face after sewing), ``volumes``
-        (per solid, positive when oriented outward).
+        ``sewing_free_edges`` (edges bounding one face after sewing); the volumes are
+        :func:`solid_volumes`'.
     """
     from OCP.BRep import BRep_Builder
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing
@@ -366,7 +366,7 @@ def build_solids(faces, groups, tolerance: float):
     from OCP.TopoDS import TopoDS, TopoDS_Compound
     comp, bld = TopoDS_Compound(), BRep_Builder()
     bld.MakeCompound(comp)
-    free, volumes = 0, []
+    free = 0
     for group in groups:
         sw = BRepBuilderAPI_Sewing(tolerance)
         for i in group:
@@ -382,13 +382,22 @@ def build_solids(faces, groups, tolerance: float):
             if free_edge_count(shell) == 0:
                 fix = ShapeFix_Solid(BRepBuilderAPI_MakeSolid(shell).Solid())
                 fix.Perform()
-                solid = fix.Shape()
-                volumes.append(_volume(solid))
-                bld.Add(comp, solid)
+                bld.Add(comp, fix.Shape())
             else:
                 bld.Add(comp, shell)
             exp.Next()
-    return comp, {"sewing_free_edges": free, "volumes": volumes}
+    return comp, {"sewing_free_edges": free}
+
+
+def solid_volumes(shape) -> list:
+    """The volume of each solid of ``shape``, in its order (positive: outward)."""
+    from OCP.TopAbs import TopAbs_SOLID
+    from OCP.TopExp import TopExp_Explorer
+    out, exp = [], TopExp_Explorer(shape, TopAbs_SOLID)
+    while exp.More():
+        out.append(_volume(exp.Current()))
+        exp.Next()
+    return out
 
 
 @dataclass
@@ -491,16 +500,18 @@ def brep_shape(model: CadModel):
     CadInputError
         A face whose boundary crosses itself (named by its patch).
     """
-    shape, rep = _brep(model, CAD_KINDS)
+    pieces = occ_faces(model.pieces)
+    shape, rep = _brep(model, CAD_KINDS, pieces)
     pieced = {int(k) for k in model.piece_patch}
     curved = [k for k, s in enumerate(model.surfaces)
               if s is not None and s.kind in _DOUBLY_CURVED and k in pieced]
     if curved and not is_valid(shape):
         plain = tuple(k for k in CAD_KINDS if k not in _DOUBLY_CURVED)
-        shape2, rep2 = _brep(model, plain)
+        shape2, rep2 = _brep(model, plain, pieces)
         if is_valid(shape2):
-            rep2["pieced_for_validity"] = curved
-            return shape2, rep2
+            shape, rep = shape2, rep2
+            rep["pieced_for_validity"] = curved
+    rep["volumes"] = solid_volumes(shape)
     return shape, rep
 
 
@@ -509,9 +520,10 @@ def brep_shape(model: CadModel):
 _DOUBLY_CURVED = ("sphere", "torus")
 
 
-def _brep(model: CadModel, kinds):
+def _brep(model: CadModel, kinds, pieces: list):
     """:func:`brep_shape` with the patches of ``kinds`` as trimmed faces and the others
-    as their pieces (those with none are left out)."""
+    as their pieces (``pieces``: the faces of ``model.pieces``; patches with none are
+    left out)."""
     diag = model.diagonal if model.diagonal > 0 else 1.0
     tol = max(SEW_TOL * diag, 2.0 * model.gap)
     analytic = [k for k, s in enumerate(model.surfaces) if s is not None and s.kind in kinds]
@@ -527,7 +539,7 @@ def _brep(model: CadModel, kinds):
                                    name=model.name(k), curves=model.curves))
         info.append({"patch": k, "kind": s.kind, "residual": float(s.residual / diag)})
     trimmed = set(analytic)
-    for pc, k in zip(occ_faces(model.pieces), model.piece_patch):
+    for pc, k in zip(pieces, model.piece_patch):
         if int(k) in trimmed:
             continue
         of_patch.setdefault(int(k), []).append(len(faces))
