@@ -52,7 +52,12 @@ Pipeline of :func:`snap` (``mode="rough"``)
    would chain them).
 5. Corners: where a stroke turns by more than ``corner_angle`` between the
    chords ``tol * corner_window`` before and after a point (local maximum),
-   and no junction is within ``tol``, it gets a degree-2 vertex.
+   and no junction is within ``2 tol``, it gets a degree-2 vertex. Where ``tol``
+   is wider than :data:`DEFAULT_SNAP_TOL` (a tolerance measured from wide gaps, not
+   from how tightly the strokes curve), the turn is the smaller of that and its mean
+   with the turn over chords ``corner_window`` times the default tolerance: a circle
+   turns half as much over half the chord, a corner as much, so a circle as tight
+   as the wide window is not cut into corners.
 6. Each stroke is moved onto its junctions with displacement bumps
    ``d_j (1 - x^2)^2``, ``x = |s - s_j| / R_j`` (C1, zero slope at the junction,
    so no kink; ``R_j <= blend * tol`` and at most 0.45 of the distance to the
@@ -61,11 +66,13 @@ Pipeline of :func:`snap` (``mode="rough"``)
    the last junction is an overshoot and is trimmed; longer ones stay as
    dangling edges (degree-1 vertices, listed in the report).
 7. Degree-2 vertices made only by stroke ends meeting smoothly (gap closing:
-   join angle below ``corner_angle``; the turn over chords ``corner_window *
-   tol``, or its mean with the turn over half that where smaller, so that a join
-   on a curve as tight as the window is smooth) are dissolved, unless the joined curve
-   turns sharply once within ``2 tol`` of the join (a corner the per-stroke
-   search could not see, too close to a stroke end): the vertex moves there.
+   join angle below ``corner_angle``; the turn over chords ``w = corner_window``
+   times the smaller of ``tol`` and the default tolerance, or its mean with the turn
+   over ``w / 2`` where smaller, so that a join on a curve as tight as the window is
+   smooth) are dissolved, unless the joined curve turns sharply once within ``2 tol``
+   of the join and farther than ``corner_window * tol`` from its ends (a corner the
+   per-stroke search could not see, too close to a stroke end; nearer the ends, the
+   bumps onto their junctions bend it): the vertex moves there.
    Parallel edges between the same vertices closer than ``2 tol`` (left-over
    overdraw) are averaged; a junction left of degree 2 by that is dissolved as above.
 
@@ -157,7 +164,9 @@ class SnapOptions:
         Degrees; a turn sharper than this within a stroke is a degree-2 vertex,
         and two stroke ends meeting at a sharper angle stay a vertex.
     corner_window : float
-        Chord length (times ``tol``) on each side used to measure a turn.
+        Chord length (times ``tol``) on each side used to measure a turn; above
+        the default tolerance, curvature is discounted over ``corner_window`` times
+        the default (see step 5 of :mod:`curvenet.snap`).
     trim : float
         Free end pieces past a junction shorter than ``trim * tol`` are trimmed.
     blend : float

@@ -47,22 +47,25 @@ def join_turn(c1, c2, w):
     return float(min(t_w, 0.5 * (t_w + t_h)))
 
 
-def _corner_near_join(curve, s_join, tol, opts):
+def _corner_near_join(curve, s_join, tol, w, opts):
     """Arc parameter of a lone sharp turn next to a join on the joined curve, or None.
 
     The per-stroke corner search cannot see a turn closer than ``corner_window *
     tol`` to a stroke end (no chord beyond it), nor one within ``2 tol`` of a
     junction. A stroke that goes round a corner and stops just past it, joined to
     the next stroke, hides its corner there; on the joined curve both chords exist.
-    The turn is measured as in the per-stroke search, over the join's ``2 tol``
-    plus one chord on each side. A corner is taken only where the turn exceeds
-    ``corner_angle`` in one run there (a tight curl or a zigzag has several),
-    peaking between ``tol / 4`` (closer, the join itself is the turn, and it was
-    found smooth) and ``2 tol`` from the join.
+    The turn is measured over chords ``w`` (the join chord, see :func:`dissolve`),
+    over the join's ``2 tol`` plus one chord on each side, and no closer than
+    ``corner_window * tol`` to the joined curve's ends: there the bumps that move
+    the curve onto the junctions at its ends bend it (a short chord sees that bend
+    as a turn). A corner is taken only where the turn exceeds ``corner_angle`` in one
+    run there (a tight curl or a zigzag has several), peaking between ``tol / 4``
+    (closer, the join itself is the turn, and it was found smooth) and ``2 tol``
+    from the join.
     """
-    w = opts.corner_window * tol
     cum = cumulative_length(curve)
-    lo, hi = max(w, s_join - 2.0 * tol - w), min(cum[-1] - w, s_join + 2.0 * tol + w)
+    e = opts.corner_window * tol
+    lo, hi = max(e, s_join - 2.0 * tol - w), min(cum[-1] - e, s_join + 2.0 * tol + w)
     if hi - lo < 0.5 * tol:
         return None
     s = np.linspace(lo, hi, int((hi - lo) / (0.05 * tol)) + 2)
@@ -82,13 +85,16 @@ def _split(curve, s):
     return np.vstack([curve[cum < s], p]), np.vstack([p, curve[cum > s]])
 
 
-def dissolve(edges, corner_ids, tol, opts, verts, report):
+def dissolve(edges, corner_ids, tol, w, opts, verts, report):
     """Join the two edges at each smooth degree-2 vertex that is not a corner.
 
-    Vertices are visited in increasing id, each once, with the incidence updated
-    after each join. Where the joined curve turns sharply within ``2 tol`` of the
-    join (:func:`_corner_near_join`), the vertex moves to that corner (``verts``
-    is updated in place) instead of being dissolved.
+    The join turn (:func:`join_turn`) is measured over chords ``w``: ``corner_window``
+    times the smaller of ``tol`` and the default tolerance
+    (:func:`curvenet.snap.rough.corner_chords`). Vertices are visited in increasing
+    id, each once, with the incidence updated after each join. Where the joined
+    curve turns sharply within ``2 tol`` of the join (:func:`_corner_near_join`), the
+    vertex moves to that corner (``verts`` is updated in place) instead of being
+    dissolved.
 
     Returns the new edge list; the dissolved vertices are added to
     ``report["dissolved_joins"]`` and the moved ones to ``report["corners"]``.
@@ -98,7 +104,6 @@ def dissolve(edges, corner_ids, tol, opts, verts, report):
     for e_id, e in enumerate(edges):
         inc[e[0]].add(e_id)
         inc[e[1]].add(e_id)
-    w = opts.corner_window * tol
     for v in range(len(verts)):
         if len(inc[v]) != 2 or v in corner_ids:
             continue
@@ -116,7 +121,7 @@ def dissolve(edges, corner_ids, tol, opts, verts, report):
         joined = np.vstack([c1, c2[1:]])
         srcs = tuple(sorted(set(e1[3]) | set(e2[3])))
         s_join = float(cumulative_length(c1)[-1])
-        at = _corner_near_join(joined, s_join, tol, opts)
+        at = _corner_near_join(joined, s_join, tol, w, opts)
         if at is not None:  # the sources of the piece that holds the other stroke's part
             a, b = _split(joined, at)
             verts[v] = a[-1]

@@ -11,6 +11,7 @@ from scipy.ndimage import maximum_filter1d
 from scipy.spatial import cKDTree
 
 from .auto import check_density
+from .graph import DEFAULT_SNAP_TOL
 from .joins import chord_turn, dissolve
 from .merge import components, join_near
 from .overdraw import close_loops, consolidate, merge_slivers
@@ -316,15 +317,31 @@ def _cluster(samples, pos, mk, ms, tol, h):
     return J, per_stroke
 
 
-def _corners(samples, tol, h, opts):
+def corner_chords(tol, diag, opts):
+    """Chord lengths ``(w, w0)`` of the turn measurements: ``w = corner_window * tol`` and
+    ``w0 = corner_window * min(tol, DEFAULT_SNAP_TOL * diag)``.
+
+    A tolerance above the default is measured from how far stroke ends stop from other
+    strokes, not from how tightly the strokes curve; joins are judged over ``w0`` and
+    the corner search discounts curvature with it (:func:`_corners`). At or below the
+    default the two are equal.
+    """
+    return opts.corner_window * tol, opts.corner_window * min(tol, DEFAULT_SNAP_TOL * diag)
+
+
+def _corners(samples, w, w0, h, opts):
     """Sharp turns: ``{stroke: [s, ...]}``, local maxima of the turn above the threshold.
 
     The turn at ``s`` is the angle between the chords ``p(s - w) -> p(s)`` and
     ``p(s) -> p(s + w)``, ``w = corner_window * tol``, evaluated every ``h / 2``
-    on all strokes at once.
+    on all strokes at once. Where ``w0 < w`` (a tolerance wider than the default,
+    :func:`corner_chords`), it is the smaller of that and its mean with the turn over
+    the chords ``w0``: a smooth curve turns in proportion to the chord, a corner
+    does not, so a circle as tight as the wide window (a torus's small circle at a
+    tolerance measured from wide gaps) is not cut into corners, while a corner
+    rounded over more than ``w0`` still turns enough over ``w``.
     """
     flat = samples[5]
-    w = opts.corner_window * tol
     ok = np.flatnonzero(flat.L > 2 * w)
     if opts.corner_angle >= 180 or ok.size == 0:
         return {}
@@ -338,6 +355,9 @@ def _corners(samples, tol, h, opts):
     p0, p1, p2 = flat.interp(kk, s - w), flat.interp(kk, s), flat.interp(kk, s + w)
     ang = np.full(start[-1], -1.0)
     ang[pos] = chord_turn(p0, p1, p2)
+    if w0 < w:
+        t0 = chord_turn(flat.interp(kk, s - w0), p1, flat.interp(kk, s + w0))
+        ang[pos] = np.minimum(ang[pos], 0.5 * (ang[pos] + t0))
     peak = (ang >= maximum_filter1d(ang, 2 * pad - 1, mode="nearest")) & (ang > opts.corner_angle)
     out = {}
     inv = -np.ones(start[-1], dtype=np.int64)
@@ -414,7 +434,8 @@ def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
     nj = len(J)
     verts = [p for p in J]
     corner_ids = set()
-    for k, found in sorted(_corners(samples, tol, h, opts).items()):  # degree-2 vertices
+    w, w0 = corner_chords(tol, diag, opts)
+    for k, found in sorted(_corners(samples, w, w0, h, opts).items()):  # degree-2 vertices
         taken = [s for s, _ in per_stroke.get(k, [])]
         for s in found:
             if all(abs(s - t) > 2.0 * tol for t in taken):
@@ -484,10 +505,10 @@ def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
             report["t_junctions"] += 1
         elif through[j] == 0 and ends_at[j] >= 2:
             report["gap_merges"] += 1
-    edges = dissolve(edges, corner_ids, tol, opts, verts, report)
+    edges = dissolve(edges, corner_ids, tol, w0, opts, verts, report)
     edges, report["slivers_merged"] = merge_slivers(edges, tol)
     if report["slivers_merged"]:  # a junction of slivers may be left of degree 2
-        edges = dissolve(edges, corner_ids, tol, opts, verts, report)
+        edges = dissolve(edges, corner_ids, tol, w0, opts, verts, report)
     used = sorted({e[0] for e in edges} | {e[1] for e in edges})
     new_id = {v: i for i, v in enumerate(used)}
     net = CurveNetwork(np.array([verts[v] for v in used]).reshape(-1, 3))

@@ -187,12 +187,70 @@ def test_corner_near_join_only_for_a_lone_turn():
     from curvenet.snap.joins import _corner_near_join
     from curvenet.snap.graph import SnapOptions
     tol, opts = 0.05, SnapOptions()
+    w = opts.corner_window * tol
     ell = _path((-1, 0, 0), (0, 0, 0), (0, 1, 0))
-    at = _corner_near_join(ell, 1.0 - 1.2 * tol, tol, opts)
+    at = _corner_near_join(ell, 1.0 - 1.2 * tol, tol, w, opts)
     assert at is not None and abs(at - 1.0) < 0.1 * tol
-    assert _corner_near_join(ell, 1.0, tol, opts) is None
+    assert _corner_near_join(ell, 1.0, tol, w, opts) is None
     zig = _path(*[(0.6 * tol * k, 0.5 * tol * (k % 2), 0) for k in range(40)])
-    assert _corner_near_join(zig, 20 * 0.78 * tol, tol, opts) is None
+    assert _corner_near_join(zig, 20 * 0.78 * tol, tol, w, opts) is None
+
+
+@pytest.mark.parametrize("chord,at", [(0.5, 1.1), (0.75, 1.35)])
+def test_corner_near_join_not_in_the_bend_at_an_end_junction(chord, at):
+    """A joined curve measured over chords of ``chord`` tol, shorter than ``corner_window
+    * tol`` (a tolerance wider than the default): a bend ``at`` tol from the curve's
+    end, where the bump onto the end junction bends it, is no corner next to a join 1.5
+    tol beyond it; the L corner 1.2 tol from the join, away from the ends, still is."""
+    from curvenet.snap.joins import _corner_near_join
+    from curvenet.snap.graph import SnapOptions
+    tol, opts = 0.05, SnapOptions()
+    w = chord * tol
+    bend = _path((0, 0, 0), (at * tol, 0, 0), (at * tol + 0.3, 0.8, 0))  # turns 69 degrees
+    assert _corner_near_join(bend, (at + 1.5) * tol, tol, w, opts) is None
+    ell = _path((-1, 0, 0), (0, 0, 0), (0, 1, 0))
+    at = _corner_near_join(ell, 1.0 - 1.2 * tol, tol, w, opts)
+    assert at is not None and abs(at - 1.0) < 0.1 * tol
+
+
+def _frame_lines(half):
+    """Two lines along z through (+-1, 0.01, 0), from z = -half to half."""
+    return [_line((x, 0.01, -half), (x, 0.01, half), 200) for x in (-1.0, 1.0)]
+
+
+@pytest.mark.parametrize("snap_tol", [0.06, 0.065])
+def test_circle_as_tight_as_a_wide_window_gets_no_corners(snap_tol):
+    """A unit circle drawn as one closed stroke, crossed by two lines: at a tolerance
+    wider than the default its chords of 1.5 tol turn by 55-60 degrees, but it is a
+    circle (half the chord, half the turn): two crossings and the two half circles
+    between them, no degree-2 corner on either (they were cut at their middles)."""
+    t = np.linspace(0.0, 2 * np.pi, 400)
+    ring = np.stack([np.cos(t), np.sin(t), 0 * t], axis=1)
+    net = snap(Sketch([ring] + _frame_lines(5.0)), snap_tol=snap_tol)
+    deg = np.bincount(net.endpoints.ravel(), minlength=net.number_of_vertices)
+    assert sorted(deg.tolist()) == [1, 1, 1, 1, 4, 4] and net.number_of_edges == 6
+    assert net.report["corners"] == 0
+
+
+@pytest.mark.parametrize("fillet", [0.0, 0.5])
+def test_square_corners_stay_at_a_wide_tolerance(fillet):
+    """A square of side 2 drawn as one closed stroke, its corners sharp or rounded with a
+    radius of ``fillet`` tol, at a tolerance wider than the default: four corners."""
+    snap_tol = 0.06
+    diag = np.linalg.norm([2.0, 2.0, 2.0])
+    r = fillet * snap_tol * diag
+    pts = []
+    for k, (cx, cy) in enumerate([(1, 1), (-1, 1), (-1, -1), (1, -1)]):
+        a0 = np.pi / 2 * k
+        c = np.array([cx - r * np.sign(cx), cy - r * np.sign(cy)])
+        a = np.linspace(a0, a0 + np.pi / 2, 9 if r else 1)
+        pts.append(np.stack([c[0] + r * np.cos(a), c[1] + r * np.sin(a)], axis=1))
+    corners = np.vstack([[(1.0, 0.0)]] + pts + [[(1.0, 0.0)]])  # from the middle of a side
+    square = _path(*[(x, y, 0.0) for x, y in corners])
+    frame = [_line((q, q, q), (q, q + 0.001, q), 2) for q in (-1, 1)]  # dropped
+    net = snap(Sketch([square] + frame), snap_tol=snap_tol)
+    assert (net.number_of_vertices, net.number_of_edges) == (4, 4)
+    assert net.report["corners"] == 4
 
 
 @pytest.mark.parametrize("offset", [1.1, 1.45])
