@@ -32,6 +32,7 @@ __all__ = [
     "ZERO_LENGTH",
     "COINCIDENT_REL",
     "DUPLICATE_POINT_REL",
+    "DEFAULT_SNAP_TOL",
     "DEGENERATE_AREA_REL",
     "SNAP_TOL_RANGE",
     "check_snap_tol",
@@ -104,3 +105,13 @@ def check_snap_tol(value) -> float:
         raise InvalidParameterError(f"snap_tol must be in ({lo:g}, {hi:g}] (a fraction of the "
                                     f"bounding-box diagonal), got {value!r}")
     return x
+
+#: Default snapping tolerance, a fraction of the bounding-box diagonal. Chosen so
+#: that rough redraws (0.3% wobble, ends off by up to 1.5%, 1% gaps) snap
+#: reliably: two ends that both stop 1.5% short of a right-angle corner are
+#: 2.1% apart. Measured: 100/100 seeded redraws recovered for each of box,
+#: L-prism, lat-long sphere and saddle grid (tests/curvenet/test_snap.py, slow).
+#: Curves drawn closer together than this are taken as one curve: use a smaller
+#: value for dense curve grids (e.g. 0.005 for the Neveu et al. gridshells).
+#: Re-exported by :mod:`curvenet.snap`.
+DEFAULT_SNAP_TOL = 0.025

@@ -110,8 +110,8 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..core.geometry import densify_polylines, segment_closest
-from ..core.tolerances import (COINCIDENT_REL, DIVISION_GUARD, DUPLICATE_POINT_REL,
-                               check_snap_tol)
+from ..core.tolerances import (COINCIDENT_REL, DEFAULT_SNAP_TOL, DIVISION_GUARD,
+                               DUPLICATE_POINT_REL, check_snap_tol)
 from ..core.errors import InvalidParameterError
 from .merge import components, first_items
 from .strokes import dedup
@@ -135,15 +135,6 @@ CROSSING_ANGLE = 20.0
 CROSSING_STEP = 0.005
 #: Samples whose neighbours the crossing test gathers at a time (bounds its memory).
 _CROSSING_CHUNK = 20_000
-
-#: Default snapping tolerance, a fraction of the bounding-box diagonal. Chosen so
-#: that rough redraws (0.3% wobble, ends off by up to 1.5%, 1% gaps) snap
-#: reliably: two ends that both stop 1.5% short of a right-angle corner are
-#: 2.1% apart. Measured: 100/100 seeded redraws recovered for each of box,
-#: L-prism, lat-long sphere and saddle grid (tests/curvenet/test_snap.py, slow).
-#: Curves drawn closer together than this are taken as one curve: use a smaller
-#: value for dense curve grids (e.g. 0.005 for the Neveu et al. gridshells).
-DEFAULT_SNAP_TOL = 0.025
 
 #: Counters present in every ``network.report`` (see :func:`snap`).
 _COUNTERS = ("crossings", "t_junctions", "gap_merges", "closed_strokes", "overdrawn_loops",

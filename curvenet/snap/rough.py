@@ -11,13 +11,12 @@ from scipy.ndimage import maximum_filter1d
 from scipy.spatial import cKDTree
 
 from .auto import check_density
-from .graph import DEFAULT_SNAP_TOL
 from .joins import chord_turn, dissolve
 from .merge import components, join_near
 from .overdraw import close_loops, consolidate, merge_slivers
 from .strokes import Strokes, bump, clean, sample
 from ..core.geometry import arc_length, interpolate_polyline, segment_closest
-from ..core.tolerances import DIVISION_GUARD
+from ..core.tolerances import DEFAULT_SNAP_TOL, DIVISION_GUARD
 from ..model.network import CurveNetwork
 
 __all__ = ["snap_rough"]
