@@ -163,14 +163,17 @@ class CurveNetwork:
     # --- serialisation ------------------------------------------------------
     def to_dict(self) -> dict:
         """JSON-ready dict in the ``curvenet.model.network`` version-1 layout."""
+        sizes = [len(e.curve) for e in self.edges]
+        points = np.concatenate([e.curve for e in self.edges]).tolist() if sizes else []
+        ends = np.cumsum(sizes).tolist()
         return {
             "format": "curvenet.network",
             "version": 1,
             "vertices": self.positions.tolist(),
             "edges": [
-                {"u": e.u, "v": e.v, "curve": e.curve.tolist(), "strokes": list(e.strokes),
+                {"u": e.u, "v": e.v, "curve": points[b - n:b], "strokes": list(e.strokes),
                  "label": e.label}
-                for e in self.edges
+                for e, n, b in zip(self.edges, sizes, ends)
             ],
         }
 
