@@ -454,7 +454,7 @@ def _judge(plan: _Plan, decision: RouteDecision, settings: SurfaceSettings, clos
     from .cycles.find import find_patches
     other = "faces" if mode == "basis" else "basis"
     alt = find_patches(net, close=close, mode=other)
-    check["coverage"][other] = coverage(alt)[0]
+    check["coverage"][other], alt_unused = coverage(alt)
     if alt.patches and check["coverage"][other] >= diag["coverage"] - 1e-9:
         alt_res, alt_name = _surface_route(plan, decision, settings, sketch=sketch, net=net,
                                            ps=alt, timings=timings, diag=diag)
@@ -462,7 +462,8 @@ def _judge(plan: _Plan, decision: RouteDecision, settings: SurfaceSettings, clos
         check["walls"][other] = len(verdict["walls"])
         if verdict["passes"]:
             check.update(taken=other, nonmanifold=verdict["nonmanifold"])
-            diag["patches"] = len(alt.patches)
+            diag.update(patches=len(alt.patches), coverage=check["coverage"][other],
+                        unused_edges=alt_unused)
             return alt_res, alt, replace(decision, patches=len(alt.patches), check=check), alt_name
     check["wall_area"] = wall_area(res.vertices, res.faces, res.face_patch, first["walls"])
     if check["wall_area"] < JUDGE_WALL_AREA:

@@ -17,6 +17,7 @@ import curvenet
 import curvenet.cycles.find as find
 from curvenet.datasets import shapes
 from curvenet.evaluate import evaluate_mesh
+from curvenet.route.decision import coverage
 
 _find = find.find_patches
 
@@ -41,6 +42,9 @@ def test_auto_replaces_walls_by_the_faces_that_cover_as_much(basis_first):
     assert check["nonmanifold"] == 0
     assert check["coverage"]["faces"] == pytest.approx(check["coverage"]["basis"]) == 1.0
     assert len(res.patchset.patches) == 12
+    assert res.diagnostics["patches"] == 12             # the figures of the set taken
+    assert res.diagnostics["coverage"] == check["coverage"]["faces"]
+    assert res.diagnostics["unused_edges"] == coverage(res.patchset)[1]
     assert "coverage basis 100%, faces 100%; kept the faces patches" in \
         res.decision.explain_check()
     assert _fscore(res, shape) > 0.99
