@@ -355,8 +355,8 @@ def build_solids(faces, groups, tolerance: float):
     shape : TopoDS_Compound
         The solids and the open shells (a lone face as it is).
     report : dict
-        ``sewing_free_edges`` (edges bounding one face after sewing); the volumes are
-        :func:`solid_volumes`'.
+        ``sewing_free_edges`` (edges bounding one face after sewing); the solids'
+        volumes come from :func:`solid_volumes`.
     """
     from OCP.BRep import BRep_Builder
     from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeSolid, BRepBuilderAPI_Sewing

@@ -440,17 +440,16 @@ def _orient(J: _Junctions, normal: np.ndarray, strength: np.ndarray):
     Returns ``(sign, conflicts)``, ``sign`` ``(N,) int64``.
     """
     V, n = J.votes, len(J.nodes)
-    s = np.ones(n + 1, np.int64)
+    s = np.ones(n, np.int64)
     if len(V.ia) == 0:
-        return s[:n], 0
+        return s, 0
     ia, ib = V.ia, V.ib
     carried = np.einsum("cij,cj->ci", V.transport, normal[ia])
     carried /= np.maximum(np.linalg.norm(carried, axis=1, keepdims=True), DIVISION_GUARD)
     dot = np.einsum("ij,ij->i", carried, normal[ib])
     weight = np.abs(dot) * np.minimum(strength[ia], strength[ib])
-    by = np.lexsort((np.arange(len(weight)), -weight, V.group))
-    best = np.empty(len(V.key), np.int64)
-    best[V.group[by[::-1]]] = by[::-1]             # the first of each group's best wins
+    by = np.lexsort((np.arange(len(weight)), -weight, V.group))     # group, best first
+    best = by[np.r_[True, V.group[by][1:] != V.group[by][:-1]]]     # one per group, in order
     lo, hi = np.minimum(ia[best], ib[best]), np.maximum(ia[best], ib[best])
     r, c = _spanning_tree(lo, hi, 2.0 - weight[best], n)
     code = r * n + c
@@ -473,7 +472,6 @@ def _orient(J: _Junctions, normal: np.ndarray, strength: np.ndarray):
                     seen[y] = True
                     s[y] = -s[x] if f else s[x]
                     stack.append(y)
-    s = s[:n]
     conflicts = int(np.count_nonzero((s[ia] * s[ib] * np.sign(dot) < 0) & (weight > 0.1)))
     return s, conflicts
 

@@ -276,7 +276,6 @@ def _crosses(strokes, diag, points: _Points) -> bool:
     within ``CROSSING_AWAY`` of a shared point along its own stroke is near without a
     search. ``points`` (of the same strokes) are reused when the sampling adds none.
     """
-    eps = COINCIDENT_REL * diag
     step = CROSSING_STEP * diag
     away = CROSSING_AWAY * diag
     pts, counts = densify_polylines(strokes, step)
@@ -286,7 +285,7 @@ def _crosses(strokes, diag, points: _Points) -> bool:
         tree, shared = points.tree, points.pairs
     else:
         tree = cKDTree(pts)
-        shared = tree.query_pairs(eps, output_type="ndarray")
+        shared = tree.query_pairs(points.eps, output_type="ndarray")
     shared = shared[sid[shared[:, 0]] != sid[shared[:, 1]]]
     far = np.arange(len(pts))
     if len(shared):
@@ -339,7 +338,7 @@ def _snap_exact(strokes, src, labels, diag, points: _Points):
     pts = points.pts
     ids = components(len(pts), points.pairs)
     verts = pts[first_items(ids)]  # each group at its first point
-    offs = np.cumsum([0] + [len(s) for s in strokes])
+    offs = np.concatenate([[0], np.cumsum(points.counts)])
     polys = [ids[offs[k]:offs[k + 1]] for k in range(len(strokes))]
     net = indexed_network(verts, polys, labels, src)
     net.report = dict.fromkeys(_COUNTERS, 0)
