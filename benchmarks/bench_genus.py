@@ -21,12 +21,13 @@ stroke per curve with gaps, overshoots and overdraw) and ``points`` (unordered s
 of the curves, every 0.4% of the diagonal, read by point-curve recovery).
 
 Run ``python benchmarks/bench_genus.py [--only torus sphere ...] [--inputs clean rough]
-[--pictures DIR]``; prints one row per case and the worst F per family.
+[--pictures DIR] [--classical JSON]``; prints one row per case and the worst F per family.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import sys
 import time
 from pathlib import Path
@@ -137,10 +138,10 @@ def inputs(shape, kind, seed=0):
     return Sketch([pts], ["boundary"]), True
 
 
-def run(shape, kind, pictures=None):
+def run(shape, kind, pictures=None, classical=None):
     sketch, points = inputs(shape, kind)
     t = time.perf_counter()
-    res = curvenet.surface(sketch, points=points)
+    res = curvenet.surface(sketch, points=points, classical_options=classical)
     sec = time.perf_counter() - t
     m = evaluate_mesh(res.mesh, shape.reference_mesh(4), n_samples=30_000)
     ps = res.patchset
@@ -162,6 +163,8 @@ def main(argv=None):
     ap.add_argument("--only", nargs="*", help="families (torus, sphere, capsule, ...)")
     ap.add_argument("--inputs", nargs="*", default=["clean", "through", "rough", "points"])
     ap.add_argument("--pictures", type=Path, help="folder for one preview per case")
+    ap.add_argument("--classical", type=json.loads, metavar="JSON",
+                    help='classical_options of curvenet.surface, e.g. \'{"fit": "lsq"}\'')
     args = ap.parse_args(argv)
     if args.pictures:
         args.pictures.mkdir(parents=True, exist_ok=True)
@@ -173,7 +176,7 @@ def main(argv=None):
             continue
         for kind in args.inputs:
             try:
-                r = run(shape, kind, args.pictures)
+                r = run(shape, kind, args.pictures, args.classical)
             except curvenet.CurvenetError as err:
                 print(f"{shape.name:<22}{kind:<9}failed: {err}")
                 worst[(family, kind)] = 0.0

@@ -20,17 +20,25 @@ from .catmull_clark import edge_index, subdivision_step
 from .controlmesh import build_control_mesh
 from .sharp import DEFAULT_CREASE_ANGLE, sharp_structure
 from .curveupdate import fit_cubic_curve
-from .fit import (FAIRNESS, LAMBDA, VSPRING_STEP, fairness_matrix, fit_iterative, fit_lsq,
-                  variation_matrix)
+from .fit import (FAIRNESS, LAMBDA, VSPRING_STEP, bending_energy, fairness_matrix,
+                  fit_iterative, fit_lsq, variation_matrix)
 from .limit import limit_matrix, tangent_matrices
 from .polyline import point_polyline_distance
 from .sides import DEFAULT_STRAIGHT_ANGLE
 from .soap import soapfilm_mesh
 
 __all__ = ["PatchMeshResult", "surface_loops", "soapfilm_loops", "check_loops_options",
-           "DEFAULT_RESOLUTION", "DEFAULT_SUBDIV", "DEFAULT_TOL",
+           "FITS", "AUTO_FIT_MAX_VERTICES", "DEFAULT_RESOLUTION", "DEFAULT_SUBDIV", "DEFAULT_TOL",
            "DEFAULT_EDGE_LENGTH", "DEFAULT_MAX_FACES", "density_subdiv"]
 
+#: Fits of :func:`surface_loops`: ``auto`` (both below, the fairer kept), ``lsq``, ``iterative``.
+FITS = ("auto", "lsq", "iterative")
+#: ``fit="auto"`` tries the published iteration on control nets of at most this many
+#: vertices (sparse networks, where the fairness energy, not the curves, decides the
+#: shape between curves); larger nets take the least-squares fit alone.
+AUTO_FIT_MAX_VERTICES = 1000
+#: Catmull-Clark level of the limit meshes whose bending energies ``auto`` compares.
+AUTO_FIT_LEVEL = 2
 #: Control-polygon segments per curve (the paper's user-set N).
 DEFAULT_RESOLUTION = 4
 #: Catmull-Clark levels of the output mesh.
@@ -93,7 +101,7 @@ MAX_OUTPUT_FACES = 20_000_000
 
 
 def check_loops_options(*, resolution=DEFAULT_RESOLUTION, subdiv=None,
-                        edge_length=DEFAULT_EDGE_LENGTH, fit="lsq",
+                        edge_length=DEFAULT_EDGE_LENGTH, fit="auto",
                         straight_angle=DEFAULT_STRAIGHT_ANGLE, tol=DEFAULT_TOL, lam=LAMBDA,
                         curve_weight=None, fairness="variation", n_loops: int = 1,
                         **_other) -> None:
@@ -110,7 +118,7 @@ def check_loops_options(*, resolution=DEFAULT_RESOLUTION, subdiv=None,
         output that would exceed :data:`MAX_OUTPUT_FACES` triangles.
     """
     checks = [
-        ("fit", fit, lambda v: v in ("lsq", "iterative"), "'lsq' or 'iterative'"),
+        ("fit", fit, lambda v: v in FITS, f"one of {FITS}"),
         ("subdiv", subdiv, lambda v: v is None or _is_int(v) and v >= 0,
          "an integer >= 0 or None"),
         ("edge_length", edge_length, lambda v: v > 0, "> 0"),
@@ -187,7 +195,7 @@ def _is_int(value) -> bool:
 def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None =
                   DEFAULT_CREASE_ANGLE, resolution: int = DEFAULT_RESOLUTION,
                   subdiv: int | None = None, edge_length: float = DEFAULT_EDGE_LENGTH,
-                  fit: str = "lsq", update_curves=False,
+                  fit: str = "auto", update_curves=False,
                   straight_angle: float = DEFAULT_STRAIGHT_ANGLE, tol: float = DEFAULT_TOL,
                   max_iter: int = 500, lam: float = LAMBDA, curve_weight: float | None = None,
                   fairness: str = "variation", vspring_step: float = VSPRING_STEP
@@ -213,9 +221,14 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
         triangles).
     edge_length : float
         Target output edge length, fraction of the diagonal, when ``subdiv`` is None.
-    fit : {"lsq", "iterative"}
-        Direct sparse least squares with exact interpolation of the curve samples
-        (default), or the published iteration (Eq. 3 with V-spring, Eq. 4).
+    fit : {"auto", "lsq", "iterative"}
+        ``lsq``: direct sparse least squares with exact interpolation of the curve
+        samples; ``iterative``: the published iteration (Eq. 3 with V-spring, Eq. 4);
+        ``auto`` (default): ``lsq``, and on control nets of at most
+        :data:`AUTO_FIT_MAX_VERTICES` vertices also ``iterative`` (when it reaches
+        ``tol``, then corrected to interpolate the samples exactly by the change of least
+        fairness energy), keeping the one whose limit surface bends less
+        (:func:`surfacing.fit.bending_energy`).
     update_curves : bool or iterable of int
         Return curves refitted to the surface (Sec. 4.3.3): all when True, else the
         given indices (the others are returned unchanged).
@@ -259,14 +272,14 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
     update = _curve_selection(update_curves, len(curves))
     cm, curves, (crease, detected, *sharp, _), timings = _build(
         curves, loops, resolution, crease_curves, crease_angle, straight_angle)
-    P, iters, sample_dev = _fit_control_net(
+    P, iters, sample_dev, choice = _fit_control_net(
         cm, sharp, fit=fit, fairness=fairness, curve_weight=curve_weight, lam=lam, tol=tol,
         max_iter=max_iter, vspring_step=vspring_step, timings=timings)
     if subdiv is None:
         subdiv = density_subdiv(cm.vertices, cm.quads, cm.diagonal, edge_length)
     V, faces, face_patch, chains = _limit_surface(P, cm, sharp, int(subdiv), timings)
     dev, new_curves = _curve_fit_report(V, chains, curves, cm, update, timings)
-    report = _report(cm, fit=fit, dev=dev, sample_dev=sample_dev, iters=iters, timings=timings,
+    report = _report(cm, fit=choice, dev=dev, sample_dev=sample_dev, iters=iters, timings=timings,
                      crease=crease, detected=detected, n_faces=len(faces),
                      resolution=resolution, subdiv=int(subdiv))
     net = ControlNet(P, cm.quads, cm.face_patch, *sharp, list(cm.curve_vids), cm.diagonal)
@@ -302,7 +315,10 @@ def _fit_control_net(cm, sharp, *, fit, fairness, curve_weight, lam, tol, max_it
                      vspring_step, timings):
     """Control points whose limit interpolates the curve samples (Sec. 4.3.2).
 
-    Returns ``(P (n, 3) float64, iterations, sample deviations (k,) float64)``.
+    Returns ``(P (n, 3) float64, iterations, sample deviations (k,) float64, choice)``:
+    ``choice`` is the fit used and, for ``auto``, the bending energy of each fit tried
+    (``{"fit": ..., "energy": {"lsq": e, "iterative": e or None}}``; None: the iteration
+    did not reach ``tol`` within ``max_iter``).
     """
     t0 = time.perf_counter()
     sharp_edges, corners = sharp
@@ -310,22 +326,44 @@ def _fit_control_net(cm, sharp, *, fit, fairness, curve_weight, lam, tol, max_it
     L = limit_matrix(cm.quads, n, sharp_edges, corners)
     cons = np.flatnonzero(cm.on_curve)
     targets = cm.target[cons]
-    if fit == "lsq":
-        F = fairness_matrix(cm.quads, n, sharp_edges, corners)
-        if fairness == "variation":
-            F = variation_matrix(F)
-        P = fit_lsq(L, F, cm.vertices, cons, targets, curve_weight=curve_weight)
-        iters = 1
-    else:
-        diag = cm.diagonal if cm.diagonal > 0 else 1.0
+    diag = cm.diagonal if cm.diagonal > 0 else 1.0
+
+    F = fairness_matrix(cm.quads, n, sharp_edges, corners)
+    if fairness == "variation":
+        F = variation_matrix(F)
+
+    def lsq():
+        return fit_lsq(L, F, cm.vertices, cons, targets, curve_weight=curve_weight), 1
+
+    def iterative():
         T1, T2, has = tangent_matrices(cm.quads, n, sharp_edges, corners)
         P, iters, _ = fit_iterative(L, T1, T2, has, cm.quads, cm.vertices, cons, targets,
                                     lam=lam, tol=tol * diag, max_iter=max_iter,
                                     sharp_edges=sharp_edges, corners=corners,
                                     vspring_step=vspring_step)
+        return P, iters
+
+    choice = {"fit": fit}
+    if fit == "iterative":
+        P, iters = iterative()
+    else:
+        P, iters = lsq()
+    if fit == "auto":
+        choice = {"fit": "lsq", "energy": {"lsq": None, "iterative": None}}
+        if curve_weight is None and n <= AUTO_FIT_MAX_VERTICES:
+            Pi, it_i = iterative()
+            if it_i < max_iter:         # reached tol; then the least fair change that
+                # makes it interpolate the samples exactly, as the lsq fit does
+                Pi = Pi + fit_lsq(L, F, np.zeros_like(Pi), cons, targets - (L @ Pi)[cons])
+                energy = {name: bending_energy(*_limit_surface(Q, cm, sharp, AUTO_FIT_LEVEL,
+                                                               {})[:2])
+                          for name, Q in (("lsq", P), ("iterative", Pi))}
+                choice["energy"] = energy
+                if energy["iterative"] < energy["lsq"]:
+                    P, iters, choice["fit"] = Pi, it_i, "iterative"
     sample_dev = np.linalg.norm((L @ P)[cons] - targets, axis=1)
     timings["fit"] = time.perf_counter() - t0
-    return P, iters, sample_dev
+    return P, iters, sample_dev, choice
 
 
 def _limit_surface(P, cm, sharp, subdiv: int, timings):
@@ -384,7 +422,7 @@ def _report(cm, *, fit, dev, sample_dev, iters, timings, crease, detected, n_fac
     for k in cm.patch_kind:
         kinds[k] = kinds.get(k, 0) + 1
     return {
-        "fit": fit,
+        **fit,
         "max_curve_deviation": float(dev.max() / diag),
         "mean_curve_deviation": float(dev.mean() / diag),
         "max_sample_deviation": float(sample_dev.max() / diag) if len(sample_dev) else 0.0,

@@ -1,0 +1,62 @@
+"""The classical fit's choice (``fit="auto"``): the least-squares fit or the published
+V-spring iteration, whichever limit surface bends less, judged against true surfaces
+on sparse wireframes where the two differ."""
+
+import numpy as np
+import pytest
+import trimesh
+
+import curvenet
+from curvenet.datasets import sections, shapes
+from curvenet.surfacing.fit import bending_energy
+
+from ._metrics import compare
+
+
+def test_bending_energy_of_spheres_is_4pi_at_any_size():
+    s = trimesh.creation.icosphere(subdivisions=4)
+    for r in (0.01, 1.0, 300.0):
+        assert bending_energy(s.vertices * r, s.faces) == pytest.approx(4 * np.pi, rel=0.02)
+
+
+def test_bending_energy_leaves_out_the_open_boundary():
+    s = trimesh.creation.icosphere(subdivisions=4)
+    keep = s.vertices[s.faces].mean(axis=1)[:, 2] > 0.0
+    half = s.submesh([np.flatnonzero(keep)], append=True)
+    # the rim's vertices (a thin strip of the area) are out; with them the boundary's
+    # one-sided Laplacian would add far more than the half sphere's 2 pi
+    assert 0.9 * 2 * np.pi < bending_energy(half.vertices, half.faces) <= 2 * np.pi
+    flat = trimesh.creation.box().subdivide().subdivide()          # planes and 12 creases
+    plane = trimesh.Trimesh(flat.vertices, flat.faces[flat.face_normals[:, 2] > 0.9])
+    assert bending_energy(plane.vertices, plane.faces) == pytest.approx(0.0, abs=1e-9)
+
+
+def _fit(shape, fit):
+    res = curvenet.surface(shape.sketch(), method="classical",
+                           classical_options={"fit": fit, "analytic_tol": None})
+    ref = shape.reference_mesh(4)
+    m = compare(res.mesh.vertices, res.mesh.faces, ref.vertices, ref.faces, n=10000)
+    return res.diagnostics["classical"], m["fscore"]
+
+
+@pytest.mark.parametrize("make, kept", [
+    (lambda: sections.great_circles(4), "iterative"),          # triangles of a sphere
+    (lambda: sections.capsule(rings=2, meridians=3), "iterative"),   # caps over a pole
+    (lambda: shapes.torus(1.0, 0.4, n_u=4, n_v=2), "lsq"),     # V-spring inflates a torus
+])
+def test_auto_keeps_the_fit_nearer_the_true_surface(make, kept):
+    shape = make()
+    rep, f_auto = _fit(shape, "auto")
+    assert rep["fit"] == kept
+    assert set(rep["energy"]) == {"lsq", "iterative"}
+    other = {"lsq": "iterative", "iterative": "lsq"}[kept]
+    assert rep["energy"][kept] < rep["energy"][other]
+    _, f_other = _fit(shape, other)
+    assert f_auto >= 0.95 and f_auto > f_other + 0.03, (f_auto, f_other)
+
+
+def test_auto_is_the_least_squares_fit_on_large_control_nets(monkeypatch):
+    from curvenet.surfacing import api
+    monkeypatch.setattr(api, "AUTO_FIT_MAX_VERTICES", 10)
+    rep, _ = _fit(sections.great_circles(3), "auto")
+    assert rep["fit"] == "lsq" and rep["energy"] == {"lsq": None, "iterative": None}
