@@ -31,7 +31,7 @@ from .occ import free_edge_count, heal, is_valid, occ_faces
 
 __all__ = ["CadInputError", "CadModel", "brep_shape", "curve_edges", "analytic_face",
            "build_solids", "solid_volumes", "face_kinds", "manifold_groups", "EDGE_TOL", "LINE_TOL",
-           "SEW_TOL", "CAD_KINDS"]
+           "SEW_TOL", "CAD_KINDS", "nurbs_convertible"]
 
 #: Largest distance of a curve's samples to its B-spline edge, fraction of the diagonal.
 EDGE_TOL = 1e-6
@@ -479,8 +479,17 @@ def manifold_groups(boundaries) -> list:
     return [np.flatnonzero(roots == r) for r in dict.fromkeys(roots.tolist())]
 
 
-def brep_shape(model: CadModel):
+def brep_shape(model: CadModel, *, nurbs: bool = False):
     """The B-rep of ``model``: trimmed analytic faces, B-spline pieces, sewn solids.
+
+    Parameters
+    ----------
+    model : CadModel
+    nurbs : bool
+        The shape will be converted to NURBS (3DM): when OpenCascade's conversion
+        refuses the sewn shape (a trimmed torus whose periodic range came out a rounding
+        past its period raises ``Standard_DomainError``), spheres and tori are written
+        as their B-spline pieces.
 
     Returns
     -------
@@ -493,7 +502,8 @@ def brep_shape(model: CadModel):
         ``manifold_pieces``, ``shape_fixed`` (healed because the sewn shape was not
         valid), ``pieced_for_validity`` (sphere and torus patches written as their
         B-spline pieces because the shape with them trimmed was not valid; absent when
-        none).
+        none), ``pieced_for_nurbs`` (the same, because the NURBS conversion refused the
+        shape with them; absent when none).
 
     Raises
     ------
@@ -505,12 +515,15 @@ def brep_shape(model: CadModel):
     pieced = {int(k) for k in model.piece_patch}
     curved = [k for k, s in enumerate(model.surfaces)
               if s is not None and s.kind in _DOUBLY_CURVED and k in pieced]
+    plain = tuple(k for k in CAD_KINDS if k not in _DOUBLY_CURVED)
     if curved and not is_valid(shape):
-        plain = tuple(k for k in CAD_KINDS if k not in _DOUBLY_CURVED)
         shape2, rep2 = _brep(model, plain, pieces)
         if is_valid(shape2):
             shape, rep = shape2, rep2
             rep["pieced_for_validity"] = curved
+    if nurbs and curved and "pieced_for_validity" not in rep and not nurbs_convertible(shape):
+        shape, rep = _brep(model, plain, pieces)
+        rep["pieced_for_nurbs"] = curved
     rep["volumes"] = solid_volumes(shape)
     return shape, rep
 
@@ -518,6 +531,16 @@ def brep_shape(model: CadModel):
 #: Kinds whose trimmed faces fall back to their B-spline pieces when the shape with them
 #: is not valid (their curves on the surface are made from samples).
 _DOUBLY_CURVED = ("sphere", "torus")
+
+
+def nurbs_convertible(shape) -> bool:
+    """Whether OpenCascade converts ``shape`` (a ``TopoDS_Shape``) to NURBS."""
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_NurbsConvert
+    try:
+        BRepBuilderAPI_NurbsConvert(shape, True)
+    except Exception:   # OCP gives each OpenCascade exception its own class, no common base
+        return False
+    return True
 
 
 def _brep(model: CadModel, kinds, pieces: list):

@@ -137,7 +137,7 @@ def write_cad(path, model: CadModel, *, schema: str = "AP214", wires=()) -> dict
         raise InvalidParameterError(f"output {path}: {suffix!r} is not one of {CAD_FORMATS}")
     require_cad(suffix)
     quiet_occ()
-    shape, rep = brep_shape(model)
+    shape, rep = brep_shape(model, nurbs=suffix == ".3dm")
     if suffix == ".3dm":
         rep["file"] = write_3dm(path, shape, wires=wires)
     else:

@@ -209,6 +209,28 @@ def test_3dm_is_one_joined_closed_brep(tmp_path, make):
                                               "solids": 1, "valid": True, "wires": 0}
 
 
+def test_tori_go_to_3dm_as_their_pieces_when_the_nurbs_conversion_refuses(tmp_path,
+                                                                        monkeypatch):
+    """OpenCascade's torus-to-NURBS conversion raises on some sewn trimmed tori (a
+    periodic range a rounding past 2 pi: the wine glass's foot, the boat); 3DM then gets
+    the tori's B-spline pieces, STEP keeps the trimmed tori."""
+    pytest.importorskip("OCP")
+    pytest.importorskip("rhino3dm")
+    from curvenet import cad
+    from curvenet.cad import brep
+    res = surface(shapes.torus().sketch(), method="classical", subdiv=1)
+    asked = []
+    monkeypatch.setattr(brep, "nurbs_convertible", lambda shape: asked.append(shape) and False)
+    res.save(tmp_path / "t.step")
+    assert [f["kind"] for f in res.diagnostics["cad"]["faces"]] == ["torus"] * 24 and not asked
+    res.save(tmp_path / "t.3dm")
+    rep = res.diagnostics["cad"]
+    assert len(asked) == 1 and len(rep["pieced_for_nurbs"]) == 24
+    assert {f["kind"] for f in rep["faces"]} == {"bspline"}
+    (b,) = cad.read_3dm_breps(tmp_path / "t.3dm")
+    assert b.IsSolid and b.IsValid
+
+
 def test_cli_step_explain(tmp_path, capsys):
     pytest.importorskip("OCP")
     src = tmp_path / "box.json"
