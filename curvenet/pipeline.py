@@ -137,7 +137,10 @@ def export_cad(path, result: SurfaceResult, *, schema: str = "AP214",
         ``pieces`` (B-spline report), ``seams`` (G0 gap, G1 angle and deviation per
         seam between pieces), ``faces`` (per face its patch, kind and residual),
         ``file`` (what the writer reports: faces, shells, solids, free edges,
-        validity) and the B-rep figures of :func:`curvenet.cad.brep.brep_shape`.
+        validity), the B-rep figures of :func:`curvenet.cad.brep.brep_shape` and
+        ``pieced_for_trims`` (patches written as their B-spline pieces because
+        OpenCascade's wire check refused their trimmed face, :class:`curvenet.cad.
+        TrimCheckError`; absent when none).
     """
     from . import cad
     suffix = Path(path).suffix.lower()
@@ -154,10 +157,9 @@ def export_cad(path, result: SurfaceResult, *, schema: str = "AP214",
             f"neural fill (a mesh, no B-spline form) and cannot be written as CAD faces; "
             f"save a mesh format or surface with --method classical")
     from curvenet.surfacing.analytic import AnalyticSurface
-    from curvenet.surfacing.bspline import DEFAULT_LEVEL, extract_bsplines
-    from .cycles.loops import orient_boundaries
+    from curvenet.surfacing.bspline import DEFAULT_LEVEL
     rep = result.diagnostics.get("classical", {})
-    net, ps = result.network, result.patchset
+    ps = result.patchset
     surfaces = [None if a is None else AnalyticSurface.from_dict(a)
                 for a in rep.get("analytic", [None] * len(ps.patches))]
     holed_flat = [k for k, p in enumerate(ps.patches) if p.holes and surfaces[k] is None
@@ -168,27 +170,54 @@ def export_cad(path, result: SurfaceResult, *, schema: str = "AP214",
             f"their plane, and analytic faces are off (classical_options analytic_tol=None): "
             f"their control mesh covers the outer loop only; save a mesh format")
     loop_patch = rep.get("loop_patch", list(range(len(ps.patches))))
+    lv = DEFAULT_LEVEL if level is None else level
+    refused: list = []
+    while True:
+        model, bset = _cad_model(result, surfaces, loop_patch, lv)
+        try:
+            out = cad.write_cad(path, model, schema=schema, wires=result.wires)
+        except cad.TrimCheckError as err:
+            # OpenCascade refused a trimmed face the samples do not show crossing
+            # itself: that patch as its B-spline pieces, unless it is one already or
+            # has holes (its pieces cover the outer loop only)
+            if surfaces[err.patch] is None or ps.patches[err.patch].holes:
+                raise
+            surfaces[err.patch] = None
+            refused.append(err.patch)
+            continue
+        break
+    if refused:
+        out["pieced_for_trims"] = refused
+    return {"pieces": bset.report, "seams": bset.seams, **out}
+
+
+def _cad_model(result, surfaces, loop_patch, level):
+    """The :class:`curvenet.cad.CadModel` of ``result`` with ``surfaces`` per patch, and
+    the B-spline extraction it took (:func:`export_cad`)."""
+    from . import cad
+    from curvenet.surfacing.bspline import extract_bsplines
+    from .cycles.loops import orient_boundaries
+    net, ps = result.network, result.patchset
     # pieces of the faces not trimmed, and of spheres and tori (the B-rep may fall back
     # to them); without those where they cannot be extracted (a dome's polar patch)
-    lv = DEFAULT_LEVEL if level is None else level
     plain = [s is not None and s.kind in ("plane", "cylinder", "cone") for s in surfaces]
     trimmed = [s is not None and s.kind in cad.CAD_KINDS for s in surfaces]
     try:
-        bset = extract_bsplines(result.control_net, lv,
+        bset = extract_bsplines(result.control_net, level,
                                 skip=[i for i, k in enumerate(loop_patch) if plain[k]])
     except ValueError:
-        bset = extract_bsplines(result.control_net, lv,
+        bset = extract_bsplines(result.control_net, level,
                                 skip=[i for i, k in enumerate(loop_patch) if trimmed[k]])
     free = bset.pieces
     diag = bset.report.get("diagonal", 1.0)
-    gap = max([s["gap"] for s in bset.seams] + [rep.get("max_curve_deviation", 0.0)]) * diag
+    gap = max([s["gap"] for s in bset.seams]
+              + [result.diagnostics.get("classical", {}).get("max_curve_deviation", 0.0)]) * diag
     model = cad.CadModel(
         curves=[e.curve for e in net.edges], ends=[(e.u, e.v) for e in net.edges],
         positions=np.asarray(net.positions, np.float64),
         boundaries=orient_boundaries(net, ps.patches), surfaces=surfaces, pieces=free,
         piece_patch=[loop_patch[pc.patch] for pc in free], diagonal=diag, gap=gap)
-    out = cad.write_cad(path, model, schema=schema, wires=result.wires)
-    return {"pieces": bset.report, "seams": bset.seams, **out}
+    return model, bset
 
 
 def _network(sketch, patchset, *, snap_tol, timings):

@@ -29,9 +29,9 @@ import numpy as np
 from ..core.errors import CurvenetError
 from .occ import free_edge_count, heal, is_valid, occ_faces
 
-__all__ = ["CadInputError", "CadModel", "brep_shape", "curve_edges", "analytic_face",
-           "build_solids", "solid_volumes", "face_kinds", "manifold_groups", "EDGE_TOL", "LINE_TOL",
-           "SEW_TOL", "CAD_KINDS", "nurbs_convertible"]
+__all__ = ["CadInputError", "TrimCheckError", "CadModel", "brep_shape", "curve_edges",
+           "analytic_face", "build_solids", "solid_volumes", "face_kinds", "manifold_groups",
+           "EDGE_TOL", "LINE_TOL", "SEW_TOL", "CAD_KINDS", "nurbs_convertible"]
 
 #: Largest distance of a curve's samples to its B-spline edge, fraction of the diagonal.
 EDGE_TOL = 1e-6
@@ -55,6 +55,17 @@ _KIND_NAMES = {"GeomAbs_Plane": "plane", "GeomAbs_Cylinder": "cylinder",
 class CadInputError(CurvenetError):
     """A face of the network has no valid B-rep (its loop crosses itself, it does not
     close): bad input, named by its patch."""
+
+
+class TrimCheckError(CadInputError):
+    """OpenCascade's wire check finds a loop of patch ``patch`` crossing itself on its
+    analytic surface where the curves' samples do not cross in the plane's frame (or
+    no such sample test exists: cylinders, cones): the trimmed face is refused, the
+    patch may still be written as its B-spline pieces."""
+
+    def __init__(self, message: str, patch: int):
+        super().__init__(message)
+        self.patch = int(patch)
 
 
 def _pnt(p):
@@ -557,9 +568,13 @@ def _brep(model: CadModel, kinds, pieces: list):
         s = model.surfaces[k]
         if s.kind == "plane":
             _check_plane_loops(s, model.boundaries[k], model.curves, model.name(k))
+        try:
+            face = analytic_face(s, model.boundaries[k], edges, tolerance=tol,
+                                 name=model.name(k), curves=model.curves)
+        except CadInputError as err:
+            raise TrimCheckError(str(err), k) from None
         of_patch.setdefault(k, []).append(len(faces))
-        faces.append(analytic_face(s, model.boundaries[k], edges, tolerance=tol,
-                                   name=model.name(k), curves=model.curves))
+        faces.append(face)
         info.append({"patch": k, "kind": s.kind, "residual": float(s.residual / diag)})
     trimmed = set(analytic)
     for pc, k in zip(pieces, model.piece_patch):

@@ -231,6 +231,31 @@ def test_tori_go_to_3dm_as_their_pieces_when_the_nurbs_conversion_refuses(tmp_pa
     assert b.IsSolid and b.IsValid
 
 
+def test_a_trimmed_face_opencascade_refuses_becomes_its_pieces(tmp_path, monkeypatch):
+    """OpenCascade's wire check refusing a planar face whose samples do not cross (its
+    approximated edges do: mingzou/Boat, haopan/sga_torso) no longer stops the export:
+    that patch is written as its B-spline pieces and the solid stays valid."""
+    pytest.importorskip("OCP")
+    from curvenet import cad
+    from curvenet.cad import brep
+    res = surface(shapes.box().sketch(), method="classical", subdiv=1)
+    real, calls = brep.analytic_face, []
+
+    def refuse_first(surface_, boundary, *a, name, **kw):
+        calls.append(name)
+        if name.startswith("patch 2 "):
+            raise cad.CadInputError(f"{name}: its outer loop crosses itself on its plane")
+        return real(surface_, boundary, *a, name=name, **kw)
+    monkeypatch.setattr(brep, "analytic_face", refuse_first)
+    res.save(tmp_path / "b.step")
+    rep = res.diagnostics["cad"]
+    assert rep["pieced_for_trims"] == [2]
+    assert sorted(f["kind"] for f in rep["faces"]) == ["bspline"] + ["plane"] * 5
+    back = cad.shape_report(cad.read_step(tmp_path / "b.step"))
+    assert back["valid"] and back["solids"] == 1 and back["free_edges"] == 0
+    assert rep["volumes"] == [pytest.approx(1.0, rel=1e-6)]
+
+
 def test_cli_step_explain(tmp_path, capsys):
     pytest.importorskip("OCP")
     src = tmp_path / "box.json"
