@@ -154,6 +154,8 @@ def _triangulate(xy, rings, spacing):
     try:
         if len(rings) > 1:
             coarse = triangle.triangulate(pslg, "pQ")
+            if "triangles" not in coarse:   # crossing segments: some builds return no mesh
+                return None
             cen = coarse["vertices"][coarse["triangles"]].mean(axis=1)
             out = np.zeros(len(cen), bool)
             for r in rings[1:]:
@@ -162,6 +164,8 @@ def _triangulate(xy, rings, spacing):
                 pslg["holes"] = cen[out]
         got = triangle.triangulate(pslg, f"pqYYQa{area:.17f}")
     except RuntimeError:        # "Triangulation failed": crossing segments it may not split
+        return None
+    if "triangles" not in got:
         return None
     P, T = got["vertices"] * scale + lo, got["triangles"]
     m = len(P)
