@@ -173,7 +173,9 @@ def export_cad(path, result: SurfaceResult, *, schema: str = "AP214",
     lv = DEFAULT_LEVEL if level is None else level
     refused: list = []
     while True:
-        model, bset = _cad_model(result, surfaces, loop_patch, lv)
+        model, bset = cad.cad_model(result.network, ps, result.control_net, surfaces,
+                                    loop_patch, level=lv,
+                                    curve_deviation=rep.get("max_curve_deviation", 0.0))
         try:
             out = cad.write_cad(path, model, schema=schema, wires=result.wires)
         except cad.TrimCheckError as err:
@@ -189,35 +191,6 @@ def export_cad(path, result: SurfaceResult, *, schema: str = "AP214",
     if refused:
         out["pieced_for_trims"] = refused
     return {"pieces": bset.report, "seams": bset.seams, **out}
-
-
-def _cad_model(result, surfaces, loop_patch, level):
-    """The :class:`curvenet.cad.CadModel` of ``result`` with ``surfaces`` per patch, and
-    the B-spline extraction it took (:func:`export_cad`)."""
-    from . import cad
-    from curvenet.surfacing.bspline import extract_bsplines
-    from .cycles.loops import orient_boundaries
-    net, ps = result.network, result.patchset
-    # pieces of the faces not trimmed, and of spheres and tori (the B-rep may fall back
-    # to them); without those where they cannot be extracted (a dome's polar patch)
-    plain = [s is not None and s.kind in ("plane", "cylinder", "cone") for s in surfaces]
-    trimmed = [s is not None and s.kind in cad.CAD_KINDS for s in surfaces]
-    try:
-        bset = extract_bsplines(result.control_net, level,
-                                skip=[i for i, k in enumerate(loop_patch) if plain[k]])
-    except ValueError:
-        bset = extract_bsplines(result.control_net, level,
-                                skip=[i for i, k in enumerate(loop_patch) if trimmed[k]])
-    free = bset.pieces
-    diag = bset.report.get("diagonal", 1.0)
-    gap = max([s["gap"] for s in bset.seams]
-              + [result.diagnostics.get("classical", {}).get("max_curve_deviation", 0.0)]) * diag
-    model = cad.CadModel(
-        curves=[e.curve for e in net.edges], ends=[(e.u, e.v) for e in net.edges],
-        positions=np.asarray(net.positions, np.float64),
-        boundaries=orient_boundaries(net, ps.patches), surfaces=surfaces, pieces=free,
-        piece_patch=[loop_patch[pc.patch] for pc in free], diagonal=diag, gap=gap)
-    return model, bset
 
 
 def _network(sketch, patchset, *, snap_tol, timings):

@@ -28,7 +28,8 @@ from .sides import DEFAULT_STRAIGHT_ANGLE
 from .soap import soapfilm_mesh
 
 __all__ = ["PatchMeshResult", "surface_loops", "soapfilm_loops", "check_loops_options",
-           "FITS", "AUTO_FIT_MAX_VERTICES", "DEFAULT_RESOLUTION", "DEFAULT_SUBDIV", "DEFAULT_TOL",
+           "FITS", "AUTO_FIT_MAX_VERTICES", "AUTO_FIT_MAX_ITER", "DEFAULT_RESOLUTION",
+           "DEFAULT_SUBDIV", "DEFAULT_TOL",
            "DEFAULT_EDGE_LENGTH", "DEFAULT_MAX_FACES", "density_subdiv"]
 
 #: Fits of :func:`surface_loops`: ``auto`` (both below, the fairer kept), ``lsq``, ``iterative``.
@@ -36,7 +37,10 @@ FITS = ("auto", "lsq", "iterative")
 #: ``fit="auto"`` tries the published iteration on control nets of at most this many
 #: vertices (sparse networks, where the fairness energy, not the curves, decides the
 #: shape between curves); larger nets take the least-squares fit alone.
-AUTO_FIT_MAX_VERTICES = 1000
+AUTO_FIT_MAX_VERTICES = 500
+#: Steps ``auto`` gives the iteration: where it was kept it converged in 36-165 steps; one
+#: that has not by then is not taken (and would cost up to ``max_iter`` steps per fit).
+AUTO_FIT_MAX_ITER = 250
 #: Catmull-Clark level of the limit meshes whose bending energies ``auto`` compares.
 AUTO_FIT_LEVEL = 2
 #: Control-polygon segments per curve (the paper's user-set N).
@@ -226,7 +230,8 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
         samples; ``iterative``: the published iteration (Eq. 3 with V-spring, Eq. 4);
         ``auto`` (default): ``lsq``, and on control nets of at most
         :data:`AUTO_FIT_MAX_VERTICES` vertices also ``iterative`` (when it reaches
-        ``tol``, then corrected to interpolate the samples exactly by the change of least
+        ``tol`` within :data:`AUTO_FIT_MAX_ITER` steps, then corrected to interpolate
+        the samples exactly by the change of least
         fairness energy), keeping the one whose limit surface bends less
         (:func:`surfacing.fit.bending_energy`).
     update_curves : bool or iterable of int
@@ -318,7 +323,7 @@ def _fit_control_net(cm, sharp, *, fit, fairness, curve_weight, lam, tol, max_it
     Returns ``(P (n, 3) float64, iterations, sample deviations (k,) float64, choice)``:
     ``choice`` is the fit used and, for ``auto``, the bending energy of each fit tried
     (``{"fit": ..., "energy": {"lsq": e, "iterative": e or None}}``; None: the iteration
-    did not reach ``tol`` within ``max_iter``).
+    did not reach ``tol`` within its steps).
     """
     t0 = time.perf_counter()
     sharp_edges, corners = sharp
@@ -335,24 +340,25 @@ def _fit_control_net(cm, sharp, *, fit, fairness, curve_weight, lam, tol, max_it
     def lsq():
         return fit_lsq(L, F, cm.vertices, cons, targets, curve_weight=curve_weight), 1
 
-    def iterative():
+    def iterative(steps):
         T1, T2, has = tangent_matrices(cm.quads, n, sharp_edges, corners)
         P, iters, _ = fit_iterative(L, T1, T2, has, cm.quads, cm.vertices, cons, targets,
-                                    lam=lam, tol=tol * diag, max_iter=max_iter,
+                                    lam=lam, tol=tol * diag, max_iter=steps,
                                     sharp_edges=sharp_edges, corners=corners,
                                     vspring_step=vspring_step)
         return P, iters
 
     choice = {"fit": fit}
     if fit == "iterative":
-        P, iters = iterative()
+        P, iters = iterative(max_iter)
     else:
         P, iters = lsq()
     if fit == "auto":
         choice = {"fit": "lsq", "energy": {"lsq": None, "iterative": None}}
         if curve_weight is None and n <= AUTO_FIT_MAX_VERTICES:
-            Pi, it_i = iterative()
-            if it_i < max_iter:         # reached tol; then the least fair change that
+            steps = min(max_iter, AUTO_FIT_MAX_ITER)
+            Pi, it_i = iterative(steps)
+            if it_i < steps:            # reached tol; then the least fair change that
                 # makes it interpolate the samples exactly, as the lsq fit does
                 Pi = Pi + fit_lsq(L, F, np.zeros_like(Pi), cons, targets - (L @ Pi)[cons])
                 energy = {name: bending_energy(*_limit_surface(Q, cm, sharp, AUTO_FIT_LEVEL,

@@ -6,11 +6,11 @@ sewn solids), :mod:`.rhino` writes it as a joined 3DM Brep, :mod:`.export` as ST
 """
 
 from .brep import CAD_KINDS, CadInputError, CadModel, TrimCheckError, brep_shape, face_kinds
-from .export import CAD_FORMATS, STEP_SCHEMAS, read_step, write_cad, write_step
+from .export import CAD_FORMATS, STEP_SCHEMAS, cad_model, read_step, write_cad, write_step
 from .occ import require_cad, shape_report
 from .rhino import read_3dm_breps, write_3dm
 
 __all__ = ["CAD_KINDS", "CAD_FORMATS", "STEP_SCHEMAS", "CadModel", "CadInputError",
-           "TrimCheckError", "brep_shape",
+           "TrimCheckError", "brep_shape", "cad_model",
            "face_kinds", "write_cad", "write_step", "write_3dm", "read_step",
            "read_3dm_breps", "shape_report", "require_cad"]

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..core.atomic import atomic_path
 from ..core.errors import InvalidParameterError
-from .brep import CadModel, brep_shape
+from .brep import CAD_KINDS, CadModel, brep_shape
 from .occ import quiet_occ, require_cad, shape_report
 from .rhino import write_3dm
 
@@ -143,3 +143,50 @@ def write_cad(path, model: CadModel, *, schema: str = "AP214", wires=()) -> dict
     else:
         rep["file"] = write_step(path, shape, schema=schema, wires=wires)
     return rep
+
+
+def cad_model(network, patchset, control_net, surfaces, loop_patch, *, level: int,
+              curve_deviation: float = 0.0):
+    """The :class:`CadModel` of a classical surface, and the B-spline extraction it took.
+
+    Parameters
+    ----------
+    network : CurveNetwork
+    patchset : PatchSet
+    control_net : surfacing.levels.ControlNet
+        The fitted Catmull-Clark control net.
+    surfaces : list of AnalyticSurface or None
+        Per patch its analytic surface (None: a B-spline face).
+    loop_patch : list of int
+        The patch of each loop of the control net.
+    level : int
+        B-spline extraction level (:func:`surfacing.bspline.extract_bsplines`).
+    curve_deviation : float
+        The limit surface's largest deviation from the curves, fraction of the diagonal.
+
+    Returns
+    -------
+    (CadModel, BSplineSet)
+    """
+    from curvenet.surfacing.bspline import extract_bsplines
+    from ..cycles.loops import orient_boundaries
+    # pieces of the faces not trimmed, and of spheres and tori (the B-rep may fall back
+    # to them); without those where they cannot be extracted (a dome's polar patch)
+    plain = [s is not None and s.kind in ("plane", "cylinder", "cone") for s in surfaces]
+    trimmed = [s is not None and s.kind in CAD_KINDS for s in surfaces]
+    try:
+        bset = extract_bsplines(control_net, level,
+                                skip=[i for i, k in enumerate(loop_patch) if plain[k]])
+    except ValueError:
+        bset = extract_bsplines(control_net, level,
+                                skip=[i for i, k in enumerate(loop_patch) if trimmed[k]])
+    free = bset.pieces
+    diag = bset.report.get("diagonal", 1.0)
+    gap = max([s["gap"] for s in bset.seams] + [curve_deviation]) * diag
+    model = CadModel(
+        curves=[e.curve for e in network.edges], ends=[(e.u, e.v) for e in network.edges],
+        positions=np.asarray(network.positions, np.float64),
+        boundaries=orient_boundaries(network, patchset.patches), surfaces=surfaces,
+        pieces=free, piece_patch=[loop_patch[pc.patch] for pc in free], diagonal=diag,
+        gap=gap)
+    return model, bset
