@@ -231,9 +231,8 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
         Eq. 4); ``auto``: ``lsq``, and on control nets of at most
         :data:`AUTO_FIT_MAX_VERTICES` vertices also ``iterative`` (when it reaches
         ``tol`` within :data:`AUTO_FIT_MAX_ITER` steps, then corrected to interpolate
-        the samples exactly by the change of least
-        fairness energy), keeping the one whose limit surface bends less
-        (:func:`surfacing.fit.bending_energy`).
+        the samples exactly by the change of least fairness energy), keeping the one
+        whose limit surface bends less (:func:`surfacing.fit.bending_energy`).
     update_curves : bool or iterable of int
         Return curves refitted to the surface (Sec. 4.3.3): all when True, else the
         given indices (the others are returned unchanged).
@@ -332,10 +331,11 @@ def _fit_control_net(cm, sharp, *, fit, fairness, curve_weight, lam, tol, max_it
     cons = np.flatnonzero(cm.on_curve)
     targets = cm.target[cons]
     diag = cm.diagonal if cm.diagonal > 0 else 1.0
-
-    F = fairness_matrix(cm.quads, n, sharp_edges, corners)
-    if fairness == "variation":
-        F = variation_matrix(F)
+    F = None
+    if fit != "iterative":      # the fairness of lsq and of auto's exact-interpolation step
+        F = fairness_matrix(cm.quads, n, sharp_edges, corners)
+        if fairness == "variation":
+            F = variation_matrix(F)
 
     def lsq():
         return fit_lsq(L, F, cm.vertices, cons, targets, curve_weight=curve_weight), 1
