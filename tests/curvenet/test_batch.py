@@ -23,6 +23,14 @@ from curvenet.core.fidelity import stroke_fidelity
 from curvenet.io.sketch import write_sketch
 
 
+# batch mechanics, not surface density, are tested here: a coarse output keeps files quick
+COARSE = ["--edge-length", "0.03"]
+
+
+def _opts(**kw):
+    return BatchOptions(method="classical", edge_length=0.03, **kw)
+
+
 def _boxes(folder, n):
     """``n`` distinct small box sketches (heights 1, 1.1, ...), named s00, s01, ..."""
     folder.mkdir(parents=True, exist_ok=True)
@@ -51,7 +59,8 @@ def test_same_stem_inputs_are_refused_before_any_work(tmp_path, capsys):
         p.parent.mkdir()
         write_sketch(p, shapes.box().sketch())
     out = tmp_path / "out"
-    code = main(["surface", str(a), str(b), "--out-dir", str(out), "--method", "classical"])
+    code = main(["surface", str(a), str(b), "--out-dir", str(out), "--method", "classical",
+                 *COARSE])
     err = capsys.readouterr().err
     assert code == 2
     assert str(a) in err and str(b) in err and err.count("\n") == 1
@@ -76,7 +85,7 @@ def test_an_internal_error_in_one_file_does_not_stop_the_batch(tmp_path, capsys,
     monkeypatch.setattr(curvenet.pipeline, "surface", surface)
     report = tmp_path / "r.json"
     code = main(["surface", str(deep), str(broken), str(box), str(house), "--out-dir",
-                 str(tmp_path / "o"), "--method", "classical", "--report", str(report)])
+                 str(tmp_path / "o"), "--method", "classical", *COARSE, "--report", str(report)])
     out = capsys.readouterr().out
     assert code == 1  # documented: an internal failure in any file -> 1, after the batch
     assert (tmp_path / "o" / "box.obj").is_file() and (tmp_path / "o" / "house.obj").is_file()
@@ -92,7 +101,7 @@ def test_an_internal_error_in_one_file_does_not_stop_the_batch(tmp_path, capsys,
 def test_report_and_preview_paths_are_checked_before_any_work(tmp_path, capsys):
     box = _shapes(tmp_path / "in")[0]
     out = tmp_path / "out"
-    base = ["surface", str(box), "--out-dir", str(out), "--method", "classical"]
+    base = ["surface", str(box), "--out-dir", str(out), "--method", "classical", *COARSE]
     assert main(base + ["--report", str(tmp_path / "nope" / "r.csv")]) == 2
     assert main(base + ["--report", str(tmp_path / "r.txt")]) == 2
     afile = tmp_path / "afile"
@@ -121,7 +130,7 @@ def test_report_rows_and_contact_sheet(tmp_path):
     inputs = _shapes(tmp_path / "in")
     bad = tmp_path / "in" / "bad.obj"
     bad.write_text("v 0 0\n")
-    res = run_batch(inputs + [bad], tmp_path / "out", BatchOptions(method="classical"),
+    res = run_batch(inputs + [bad], tmp_path / "out", _opts(),
                     preview_dir=tmp_path / "prev")
     assert res.counts == {"ok": 4, "skipped": 0, "error": 1, "internal": 0}
     assert res.exit_code == 2
@@ -159,7 +168,7 @@ def test_a_pool_process_that_dies_costs_only_its_own_file(tmp_path, monkeypatch)
     from curvenet.batch.run import LocalExecutor
     inputs = _shapes(tmp_path / "in") + _boxes(tmp_path / "in", 2)
     monkeypatch.setattr(curvenet.batch.run, "surface_task", _crashing_task)
-    res = run_batch(inputs, tmp_path / "out", BatchOptions(method="classical"),
+    res = run_batch(inputs, tmp_path / "out", _opts(),
                     executor=LocalExecutor(2))
     status = {os.path.basename(r["input"]): r["status"] for r in res.rows}
     assert status.pop("house.obj") == "internal"
@@ -171,7 +180,7 @@ def test_an_interrupted_batch_of_20_restarts_where_it_stopped(tmp_path):
     inputs = _boxes(tmp_path / "in", 20)
     out = tmp_path / "out"
     cmd = [sys.executable, "-m", "curvenet.cli", "surface", *map(str, inputs),
-           "--out-dir", str(out), "--method", "classical"]
+           "--out-dir", str(out), "--method", "classical", *COARSE]
     proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     manifest = out / MANIFEST_NAME
     deadline = time.monotonic() + 300
@@ -200,7 +209,7 @@ def test_an_interrupted_batch_of_20_restarts_where_it_stopped(tmp_path):
 def test_skip_existing_reruns_changed_inputs_settings_and_outputs(tmp_path):
     inputs = _boxes(tmp_path / "in", 3)
     out = tmp_path / "out"
-    opts = BatchOptions(method="classical")
+    opts = _opts()
     assert run_batch(inputs, out, opts).counts["ok"] == 3
     write_sketch(inputs[0], shapes.house().sketch())  # a new input under the same name
     (out / "s01.obj").write_text("tampered\n")  # an output changed since
@@ -216,7 +225,8 @@ def test_dask_cluster_with_a_bad_file_and_a_killed_worker_matches_jobs_2(tmp_pat
     inputs = _shapes(tmp_path / "in") + _boxes(tmp_path / "in", 4)
     bad = tmp_path / "in" / "bad.obj"
     bad.write_text("l 1 2\n")
-    args = ["surface", *map(str, inputs + [bad]), "--method", "classical", "--format", "ply"]
+    args = ["surface", *map(str, inputs + [bad]), "--method", "classical", "--format", "ply",
+            *COARSE]
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster, \
             distributed.Client(cluster) as client:
@@ -270,7 +280,7 @@ def test_a_task_whose_worker_dies_for_good_is_reported_and_the_rest_goes_on(tmp_
                 os.kill(victim, signal.SIGKILL)
                 killed.append(done)
 
-        res = run_batch(inputs, tmp_path / "out", BatchOptions(method="classical"),
+        res = run_batch(inputs, tmp_path / "out", _opts(),
                         executor=DaskExecutor(client), on_row=on_row)
     # the tasks on the dead worker (running or queued there) are lost; the others run
     lost = [r for r in res.rows if r["status"] == "internal"]
@@ -284,7 +294,7 @@ def test_a_task_whose_worker_dies_for_good_is_reported_and_the_rest_goes_on(tmp_
 def test_eval_pairs_scores_a_folder_against_references(tmp_path, capsys):
     out, ref = tmp_path / "out", tmp_path / "ref"
     ref.mkdir()
-    run_batch(_shapes(tmp_path / "in")[:3], out, BatchOptions(method="classical"))
+    run_batch(_shapes(tmp_path / "in")[:3], out, _opts())
     for name in ("box", "house"):
         getattr(shapes, name)().reference_mesh().export(ref / f"{name}.ply")
     # l_prism is scored against its sketch; a box grown 1.5x about its centre is 0.25 away
