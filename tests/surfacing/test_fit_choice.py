@@ -33,8 +33,9 @@ def test_bending_energy_leaves_out_the_open_boundary():
 
 def _fit(shape, fit):
     res = curvenet.surface(shape.sketch(), method="classical",
-                           classical_options={"fit": fit, "analytic_tol": None})
-    ref = shape.reference_mesh(4)
+                           classical_options={"fit": fit, "analytic_tol": None,
+                                                  "edge_length": 0.02})
+    ref = shape.reference_mesh(2)  # fine enough for F at 1% (level 4: 0.7M faces, 10 s)
     m = compare(res.mesh.vertices, res.mesh.faces, ref.vertices, ref.faces, n=10000)
     return res.diagnostics["classical"], m["fscore"]
 
