@@ -95,7 +95,7 @@ def test_section_wireframes_embed_with_their_genus(shape, genus):
     assert faces.simple.all() and faces.genus == [genus]
     net = shape.network
     # every section lies on the surface and meets the others at shared junctions
-    ref = shape.reference_mesh(3)
+    ref = shape.reference_mesh(2)  # marching cubes on 160^3: errors ~1e-4 of the diagonal
     from curvenet.core.distance import point_surface_distance
     d = point_surface_distance(np.concatenate([e.curve for e in net.edges]), ref.vertices,
                                ref.faces)[0]
