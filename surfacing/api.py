@@ -105,7 +105,7 @@ MAX_OUTPUT_FACES = 20_000_000
 
 
 def check_loops_options(*, resolution=DEFAULT_RESOLUTION, subdiv=None,
-                        edge_length=DEFAULT_EDGE_LENGTH, fit="lsq",
+                        edge_length=DEFAULT_EDGE_LENGTH, fit="auto",
                         straight_angle=DEFAULT_STRAIGHT_ANGLE, tol=DEFAULT_TOL, lam=LAMBDA,
                         curve_weight=None, fairness="variation", n_loops: int = 1,
                         **_other) -> None:
@@ -199,7 +199,7 @@ def _is_int(value) -> bool:
 def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None =
                   DEFAULT_CREASE_ANGLE, resolution: int = DEFAULT_RESOLUTION,
                   subdiv: int | None = None, edge_length: float = DEFAULT_EDGE_LENGTH,
-                  fit: str = "lsq", update_curves=False,
+                  fit: str = "auto", update_curves=False,
                   straight_angle: float = DEFAULT_STRAIGHT_ANGLE, tol: float = DEFAULT_TOL,
                   max_iter: int = 500, lam: float = LAMBDA, curve_weight: float | None = None,
                   fairness: str = "variation", vspring_step: float = VSPRING_STEP
@@ -226,9 +226,9 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
     edge_length : float
         Target output edge length, fraction of the diagonal, when ``subdiv`` is None.
     fit : {"auto", "lsq", "iterative"}
-        ``lsq`` (default): direct sparse least squares with exact interpolation of the
-        curve samples; ``iterative``: the published iteration (Eq. 3 with V-spring,
-        Eq. 4); ``auto``: ``lsq``, and on control nets of at most
+        ``lsq``: direct sparse least squares with exact interpolation of the curve
+        samples; ``iterative``: the published iteration (Eq. 3 with V-spring, Eq. 4);
+        ``auto`` (default): ``lsq``, and on control nets of at most
         :data:`AUTO_FIT_MAX_VERTICES` vertices also ``iterative`` (when it reaches
         ``tol`` within :data:`AUTO_FIT_MAX_ITER` steps, then corrected to interpolate
         the samples exactly by the change of least fairness energy), keeping the one
