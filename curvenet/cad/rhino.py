@@ -149,14 +149,28 @@ def _bspline2d(edge, face):
 
 #: ``ON_Surface::ISO`` flags: interior ``u`` / ``v`` = constant, the W, S, E, N sides.
 _X_ISO, _Y_ISO, _W_ISO, _S_ISO, _E_ISO, _N_ISO = 1, 2, 3, 4, 5, 6
-#: openNURBS's ``ON_SQRT_EPSILON`` and ``ON_ZERO_TOLERANCE``, which its iso test uses.
-_ON_SQRT_EPSILON, _ON_ZERO_TOLERANCE = 1.490116119385e-8, 2.3283064365386962890625e-10
+#: openNURBS's ``ON_SQRT_EPSILON`` and ``ON_EPSILON``, which its parameter tolerance uses,
+#: and ``ON_ZERO_TOLERANCE``, which its iso test uses.
+_ON_SQRT_EPSILON, _ON_EPSILON = 1.490116119385e-8, 2.220446049250313e-16
+_ON_ZERO_TOLERANCE = 2.3283064365386962890625e-10
 
 
-def _parameter_tolerance(t0: float, t1: float, t: float) -> tuple:
-    """``ON_GetParameterTolerance``: the interval around ``t`` counted as ``t``."""
-    t = min(max(t, t0), t1)
-    dt = (t1 - t0) * 8.0 * _ON_SQRT_EPSILON + (abs(t0) + abs(t1)) * _ON_ZERO_TOLERANCE
+def _parameter_tolerance(surface, k: int, t: float) -> tuple:
+    """``ON_NurbsSurface::GetParameterTolerance``: the interval around ``t`` counted as
+    ``t`` in direction ``k``. Near either end of the domain it is scaled by the end
+    span, not the domain (B-spline pieces have knots refined toward their sides, so a
+    trim a little off a side is not on it)."""
+    t0, t1 = _domain_of(surface, k)
+    knots = surface.KnotsU if k == 0 else surface.KnotsV
+    order = surface.OrderU if k == 0 else surface.OrderV
+    cv_count = len(knots) - order + 2
+    if t < knots[order - 1]:
+        t1 = knots[order - 1]
+    elif t > knots[cv_count - 2]:
+        t0 = knots[cv_count - 2]
+    t = min(max(t, t0), t1)                                  # ON_GetParameterTolerance
+    dt = (t1 - t0) * 8.0 * _ON_SQRT_EPSILON + (abs(t0) + abs(t1)) * _ON_EPSILON
+    dt = min(dt, 0.5 * (t1 - t0))
     return t - dt, t + dt
 
 
@@ -177,13 +191,13 @@ def _iso(curve, surface) -> int:
     low, high, inner = ((_W_ISO, _E_ISO, _X_ISO) if k == 0 else (_S_ISO, _N_ISO, _Y_ISO))
     iso = 0
     if hi[k] <= a0 + tol[k]:
-        a, b = _parameter_tolerance(a0, a1, a0)
+        a, b = _parameter_tolerance(surface, k, a0)
         iso = low if a <= lo[k] and hi[k] <= b else 0
     elif lo[k] >= a1 - tol[k]:
-        a, b = _parameter_tolerance(a0, a1, a1)
+        a, b = _parameter_tolerance(surface, k, a1)
         iso = high if a <= lo[k] and hi[k] <= b else 0
     if not iso and (a0 < hi[k] or lo[k] < a1):
-        a, b = _parameter_tolerance(a0, a1, 0.5 * (lo[k] + hi[k]))
+        a, b = _parameter_tolerance(surface, k, 0.5 * (lo[k] + hi[k]))
         iso = inner if a <= lo[k] and hi[k] <= b else 0
     if iso and not (ext[k] < _ON_ZERO_TOLERANCE
                     and _ON_ZERO_TOLERANCE * 1024.0 <= ext[1 - k]):

@@ -209,6 +209,21 @@ def test_3dm_is_one_joined_closed_brep(tmp_path, make):
                                               "solids": 1, "valid": True, "wires": 0}
 
 
+def test_3dm_trims_near_the_sides_of_pieces_get_the_flags_opennurbs_computes(tmp_path,
+                                                                          data_dir):
+    """B-spline pieces have knots refined toward their sides, and openNURBS scales its
+    parameter tolerance with the end span: a trim a hair off a side is no side iso there,
+    and a Brep whose ``m_iso`` flags disagree is invalid (the cup's three were)."""
+    pytest.importorskip("rhino3dm")
+    pytest.importorskip("OCP")
+    from curvenet import cad
+    res = surface(data_dir / "networks" / "mingzou" / "cup.obj", method="classical",
+                  classical_options={"subdiv": 1})
+    res.save(tmp_path / "c.3dm")
+    breps = cad.read_3dm_breps(tmp_path / "c.3dm")
+    assert len(breps) == 3 and all(b.IsValid for b in breps)
+
+
 def test_tori_go_to_3dm_as_their_pieces_when_the_nurbs_conversion_refuses(tmp_path,
                                                                         monkeypatch):
     """OpenCascade's torus-to-NURBS conversion raises on some sewn trimmed tori (a
