@@ -67,6 +67,12 @@ Engineering choices (documented deviations / gap fills)
   in place (open rims), the re-integration moves it off them.
 * Final mesh: pieces of the zero set with no stroke within 4 grid cells are
   dropped (spurious level-set components of the periodic f).
+* ``attach > 0`` (draft, default): the extracted mesh is faired and pulled onto the
+  strokes near it (:mod:`neural.attach`, a stroke-constrained bi-Laplacian low-pass of
+  the vertices), and returned so only when its stroke fidelity is at least the
+  extracted mesh's. ``FlowResult.f_grid`` stays the field whose zero set was
+  extracted. Not with ``anchors``: a fill beside classical patches must meet their
+  surface, which the fairing does not see (the hybrid route closes that seam itself).
 * ``anchors`` (not in the paper): oriented points of another surface the fit must
   meet (a hybrid fill beside classical patches). Each step draws
   ``min(m, n_stroke)`` of them; they join the stroke samples in the data term
@@ -245,6 +251,9 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
     if cfg.polish > 0 and not interrupted:
         mesh, polish = _polished(fit, f_final, mesh, strokes, labels, cut_boundary)
     V, F, f_np, origin, h_world, n_cut = mesh
+    attach = None
+    if cfg.attach > 0 and not interrupted and len(F) and anchors is None:
+        V, attach = _attached(V, F, strokes, h_world, cfg)
     timings["extract"] = time.perf_counter() - t0
     timings["total"] = time.perf_counter() - t_start
     report = {"steps": steps_done, "interrupted": interrupted, "device": str(dev), "seed": seed,
@@ -253,6 +262,8 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
               "stroke_length_unit": fit.sampler.total_length}
     if polish is not None:
         report["polish"] = polish
+    if attach is not None:
+        report["attach"] = attach
     return FlowResult(V, F, report, f_grid=f_np, origin=origin, spacing=h_world, timings=timings,
                       history=fit.history)
 
@@ -273,6 +284,18 @@ def _polished(fit: FlowFit, f, mesh, strokes, labels, cut_boundary):
     fidelity = [_fidelity(m[0], m[1], strokes) for m in (mesh, polished)]
     kept = fidelity[1] >= fidelity[0]
     return (polished if kept else mesh), {"fidelity": fidelity, "kept": kept}
+
+
+def _attached(V, F, strokes, h_world, cfg: FlowConfig):
+    """The mesh faired onto its strokes (:func:`neural.attach.attach_to_strokes`) if it
+    holds at least as much of them; ``(V, {"fidelity": [before, after], "kept": bool,
+    "samples", "pulled"})``."""
+    from .attach import attach_to_strokes
+    X, rep = attach_to_strokes(V, F, strokes, h_world, cutoff=cfg.attach,
+                               weight=cfg.attach_weight)
+    fidelity = [_fidelity(V, F, strokes), _fidelity(X, F, strokes)]
+    kept = bool(np.isfinite(X).all() and fidelity[1] >= fidelity[0])
+    return (X if kept else V), dict(rep, fidelity=fidelity, kept=kept)
 
 
 def _fidelity(V, F, strokes) -> float:
