@@ -243,6 +243,33 @@ def _singular_lines(c2, trims, tis) -> None:
         trims[t]["dom"] = _domain(line)
 
 
+def _seams_on_sides(c2, trims, tis, surface) -> None:
+    """A seam trim's curve put exactly on the side of the domain it runs along, and the
+    neighbouring trims' ends onto its ends: openNURBS wants a seam's ``m_iso`` to be a
+    side, and near the ends of a B-spline piece's domain its tolerance is the end span's
+    (NURBS conversion and the loop's closing leave seams a hair off)."""
+    import rhino3dm
+    bounds = [_domain_of(surface, k) for k in (0, 1)]
+    for k, t in enumerate(tis):
+        if not trims[t]["seam"]:
+            continue
+        c = c2[trims[t]["c2i"]]
+        pts = [c.Points[i] for i in range(len(c.Points))]
+        uv = np.array([[p.X / p.W, p.Y / p.W] for p in pts])
+        off = [(np.abs(uv[:, d] - b).max(), d, b) for d in (0, 1) for b in bounds[d]]
+        gap, d, b = min(off)
+        if gap > (bounds[d][1] - bounds[d][0]) / 32.0:      # not along a side: leave it
+            continue
+        uv[:, d] = b
+        for i, p in enumerate(pts):
+            c.Points[i] = rhino3dm.Point4d(uv[i, 0] * p.W, uv[i, 1] * p.W, 0.0, p.W)
+        prev = c2[trims[tis[k - 1]]["c2i"]]
+        nxt = c2[trims[tis[(k + 1) % len(tis)]]["c2i"]]
+        for curve, i, (x, y) in ((prev, len(prev.Points) - 1, uv[0]), (nxt, 0, uv[-1])):
+            w = curve.Points[i].W
+            curve.Points[i] = rhino3dm.Point4d(x * w, y * w, 0.0, w)
+
+
 def _domain(c) -> tuple:
     d = c.Domain
     return float(d.T0), float(d.T1)
@@ -327,6 +354,7 @@ def brep_bytes(shape, tolerance: float) -> bytes:
                 we.Next()
             _singular_lines(c2, trims, tis)
             _close_loop([c2[trims[t]["c2i"]] for t in tis])
+            _seams_on_sides(c2, trims, tis, surfaces[-1])
             for t in tis:           # openNURBS checks the flag against the final curve
                 trims[t]["iso"] = _iso(c2[trims[t]["c2i"]], surfaces[-1])
             loops.append({"ti": tis, "type": _OUTER if not lis else _INNER, "fi": fi - 1})
