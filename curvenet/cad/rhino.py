@@ -153,6 +153,9 @@ _X_ISO, _Y_ISO, _W_ISO, _S_ISO, _E_ISO, _N_ISO = 1, 2, 3, 4, 5, 6
 #: and ``ON_ZERO_TOLERANCE``, which its iso test uses.
 _ON_SQRT_EPSILON, _ON_EPSILON = 1.490116119385e-8, 2.220446049250313e-16
 _ON_ZERO_TOLERANCE = 2.3283064365386962890625e-10
+#: Largest offset from a side, as a fraction of the domain, that a seam or singular trim
+#: is snapped across (conversions leave them up to about 6e-4 of it off at a pole).
+_ON_HAIR = 1e-3
 
 
 def _parameter_tolerance(surface, k: int, t: float) -> tuple:
@@ -244,21 +247,21 @@ def _singular_lines(c2, trims, tis) -> None:
 
 
 def _seams_on_sides(c2, trims, tis, surface) -> None:
-    """A seam trim's curve put exactly on the side of the domain it runs along, and the
-    neighbouring trims' ends onto its ends: openNURBS wants a seam's ``m_iso`` to be a
-    side, and near the ends of a B-spline piece's domain its tolerance is the end span's
-    (NURBS conversion and the loop's closing leave seams a hair off)."""
+    """Seam and singular trims' curves put exactly on the side of the domain they run
+    along, and the neighbouring trims' ends onto their ends: openNURBS wants their
+    ``m_iso`` to be a side, and near the ends of a B-spline piece's domain its tolerance
+    is the end span's (NURBS conversion and the loop's closing leave them a hair off)."""
     import rhino3dm
     bounds = [_domain_of(surface, k) for k in (0, 1)]
     for k, t in enumerate(tis):
-        if not trims[t]["seam"]:
+        if not (trims[t]["seam"] or trims[t]["ei"] < 0):
             continue
         c = c2[trims[t]["c2i"]]
         pts = [c.Points[i] for i in range(len(c.Points))]
         uv = np.array([[p.X / p.W, p.Y / p.W] for p in pts])
         off = [(np.abs(uv[:, d] - b).max(), d, b) for d in (0, 1) for b in bounds[d]]
         gap, d, b = min(off)
-        if gap > (bounds[d][1] - bounds[d][0]) / 32.0:      # not along a side: leave it
+        if gap > _ON_HAIR * (bounds[d][1] - bounds[d][0]):   # not on a side: leave it
             continue
         uv[:, d] = b
         for i, p in enumerate(pts):
