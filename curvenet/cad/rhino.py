@@ -155,7 +155,7 @@ _ON_SQRT_EPSILON, _ON_EPSILON = 1.490116119385e-8, 2.220446049250313e-16
 _ON_ZERO_TOLERANCE = 2.3283064365386962890625e-10
 #: Largest offset from a side, as a fraction of the domain, that a seam or singular trim
 #: is snapped across (conversions leave them up to about 6e-4 of it off at a pole).
-_ON_HAIR = 1e-3
+_SIDE_SNAP = 1e-3
 
 
 def _parameter_tolerance(surface, k: int, t: float) -> tuple:
@@ -261,7 +261,7 @@ def _seams_on_sides(c2, trims, tis, surface) -> None:
         uv = np.array([[p.X / p.W, p.Y / p.W] for p in pts])
         off = [(np.abs(uv[:, d] - b).max(), d, b) for d in (0, 1) for b in bounds[d]]
         gap, d, b = min(off)
-        if gap > _ON_HAIR * (bounds[d][1] - bounds[d][0]):   # not on a side: leave it
+        if gap > _SIDE_SNAP * (bounds[d][1] - bounds[d][0]):   # not on a side: leave it
             continue
         uv[:, d] = b
         for i, p in enumerate(pts):
