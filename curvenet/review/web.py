@@ -565,6 +565,12 @@ def serve_review(page_args: dict, *, open_browser: bool = True, say=print,
     Ctrl-C (and SIGTERM, which the CLI turns into ``SystemExit``) stops the server
     and returns; unsaved changes are named, not written: only ``Save`` writes.
     """
+    import signal
+    import threading
+    if threading.current_thread() is threading.main_thread():
+        # started with SIGINT ignored (a background job of a script, which is how
+        # Python then leaves it), Ctrl-C would never reach the loop below
+        signal.signal(signal.SIGINT, signal.default_int_handler)
     page = ReviewPage(**page_args)
     try:
         say(f"review: {page.url}  ({len(page.labels)} patches; Save writes {page.output}; "
