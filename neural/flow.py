@@ -253,7 +253,9 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
     V, F, f_np, origin, h_world, n_cut = mesh
     attach = None
     if cfg.attach > 0 and not interrupted and len(F) and anchors is None:
-        V, attach = _attached(V, F, strokes, h_world, cfg)
+        # the polish measured the fidelity of the mesh it returned
+        before = None if polish is None else polish["fidelity"][int(polish["kept"])]
+        V, attach = _attached(V, F, strokes, h_world, cfg, before)
     timings["extract"] = time.perf_counter() - t0
     timings["total"] = time.perf_counter() - t_start
     report = {"steps": steps_done, "interrupted": interrupted, "device": str(dev), "seed": seed,
@@ -286,14 +288,16 @@ def _polished(fit: FlowFit, f, mesh, strokes, labels, cut_boundary):
     return (polished if kept else mesh), {"fidelity": fidelity, "kept": kept}
 
 
-def _attached(V, F, strokes, h_world, cfg: FlowConfig):
+def _attached(V, F, strokes, h_world, cfg: FlowConfig, before: float | None = None):
     """The mesh faired onto its strokes (:func:`neural.attach.attach_to_strokes`) if it
     holds at least as much of them; ``(V, {"fidelity": [before, after], "kept": bool,
-    "samples", "pulled"})``."""
+    "samples", "pulled"})``. ``before``: the stroke fidelity of ``(V, F)`` when known."""
     from .attach import attach_to_strokes
     X, rep = attach_to_strokes(V, F, strokes, h_world, cutoff=cfg.attach,
                                weight=cfg.attach_weight)
-    fidelity = [_fidelity(V, F, strokes), _fidelity(X, F, strokes)]
+    if before is None:
+        before = _fidelity(V, F, strokes)
+    fidelity = [before, _fidelity(X, F, strokes)]
     kept = bool(np.isfinite(X).all() and fidelity[1] >= fidelity[0])
     return (X if kept else V), dict(rep, fidelity=fidelity, kept=kept)
 
