@@ -177,12 +177,17 @@ def _parameter_tolerance(surface, k: int, t: float) -> tuple:
     return t - dt, t + dt
 
 
+def _control_uv(curve) -> np.ndarray:
+    """(k, 2) float64: a 2D NURBS curve's control points in Euclidean coordinates."""
+    return np.array([[p.X / p.W, p.Y / p.W] for p in
+                     (curve.Points[i] for i in range(len(curve.Points)))])
+
+
 def _iso(curve, surface) -> int:
     """The ``m_iso`` flag openNURBS expects of a trim (``ON_Surface::IsIsoparametric``
     of the trim curve: its control points' box against the surface's domain, then
     straightness), or 0."""
-    uv = np.array([[p.X / p.W, p.Y / p.W] for p in
-                   (curve.Points[i] for i in range(len(curve.Points)))])
+    uv = _control_uv(curve)
     lo, hi = uv.min(axis=0), uv.max(axis=0)
     ext = hi - lo
     (s0, s1), (t0, t1) = (_domain_of(surface, k) for k in (0, 1))
@@ -257,15 +262,15 @@ def _seams_on_sides(c2, trims, tis, surface) -> None:
         if not (trims[t]["seam"] or trims[t]["ei"] < 0):
             continue
         c = c2[trims[t]["c2i"]]
-        pts = [c.Points[i] for i in range(len(c.Points))]
-        uv = np.array([[p.X / p.W, p.Y / p.W] for p in pts])
+        uv = _control_uv(c)
         off = [(np.abs(uv[:, d] - b).max(), d, b) for d in (0, 1) for b in bounds[d]]
         gap, d, b = min(off)
         if gap > _SIDE_SNAP * (bounds[d][1] - bounds[d][0]):   # not on a side: leave it
             continue
         uv[:, d] = b
-        for i, p in enumerate(pts):
-            c.Points[i] = rhino3dm.Point4d(uv[i, 0] * p.W, uv[i, 1] * p.W, 0.0, p.W)
+        for i in range(len(uv)):
+            w = c.Points[i].W
+            c.Points[i] = rhino3dm.Point4d(uv[i, 0] * w, uv[i, 1] * w, 0.0, w)
         prev = c2[trims[tis[k - 1]]["c2i"]]
         nxt = c2[trims[tis[(k + 1) % len(tis)]]["c2i"]]
         for curve, i, (x, y) in ((prev, len(prev.Points) - 1, uv[0]), (nxt, 0, uv[-1])):
