@@ -407,7 +407,7 @@ def _candidates(kind, p, axes, arcs):
     return [g for g in (_guess_torus(p, _unit(n), c) for c, n in lines) if g is not None]
 
 
-def fit_analytic(curves, *, tol: float, diagonal: float, kinds=KINDS):
+def fit_analytic(curves, *, tol: float, diagonal: float, kinds=KINDS, loops=None):
     """The simplest elementary surface all of a boundary's samples lie on.
 
     Parameters
@@ -420,6 +420,9 @@ def fit_analytic(curves, *, tol: float, diagonal: float, kinds=KINDS):
         The model's diagonal: radii above :data:`MAX_RADIUS` times it are refused.
     kinds : sequence of str
         Kinds tried, in this order (default :data:`KINDS`).
+    loops : list of (n_i, 3) float64, optional
+        The boundary's closed loops in walking order, a seam walked twice: with them a
+        cone face around its apex is refused too (:func:`_through_singularity`).
 
     Returns
     -------
@@ -455,6 +458,77 @@ def fit_analytic(curves, *, tol: float, diagonal: float, kinds=KINDS):
                 best = (x, res)
         if best is not None and best[1] <= tol:
             s = _rebased(_surface(kind, best[0], best[1]), p)
-            if max(abs(s.radius), s.minor if kind == "torus" else 0.0) <= MAX_RADIUS * diagonal:
+            if (max(abs(s.radius), s.minor if kind == "torus" else 0.0) <= MAX_RADIUS * diagonal
+                    and not _through_singularity(s, p, tol, loops)
+                    and (kind != "cone" or _drawn_cone(s, curves, tol))):
                 return s
     return None
+
+
+def _drawn_cone(s: AnalyticSurface, curves, tol: float) -> bool:
+    """Whether a cone's boundary holds one of the curves a cone face is drawn with: a
+    circle about its axis (a chamfer's or countersink's rim), a ruling (a line through
+    its apex) or the apex itself (a pin's point). A loop of free-form curves that happens
+    to lie within the tolerance of some cone is a free-form face: nearly flat ones fit
+    wide cones (semi-angles near 90 degrees) whose apex the face's curves on the
+    surface wander across."""
+    apex = s.origin - (s.radius / np.tan(s.minor)) * s.axis
+    for c in curves:
+        if np.linalg.norm(c[[0, -1]] - apex, axis=1).min() <= tol:
+            return True
+        u = _straight(c)
+        if u is not None:
+            off = (apex - c[0]) - ((apex - c[0]) @ u) * u
+            if np.linalg.norm(off) <= tol:
+                return True
+            continue
+        got = fit_circle(c)
+        if got is not None:
+            centre, normal, _ = got
+            d = centre - apex
+            on_axis = np.linalg.norm(d - (d @ s.axis) * s.axis) <= tol
+            if abs(normal @ s.axis) > SAME_AXIS and on_axis:
+                return True
+    return False
+
+
+#: A cone's apex within this fraction of its boundary's extent of a boundary sample is a
+#: vertex of the face (a pin's point), not inside it: the fit places the apex less
+#: precisely than the samples (a ruling's end is the only sample that fixes it).
+APEX_AT_BOUNDARY = 1e-3
+
+
+def _through_singularity(s: AnalyticSurface, p, tol: float, loops=None) -> bool:
+    """Whether the face would hold a singular point of its surface inside it.
+
+    That is a torus that crosses itself (minor radius at least the major: a spindle or
+    horn torus, its points on the axis singular), a cone whose boundary lies on both
+    sides of its apex (farther than ``tol`` along its rulings), or, given the loops, a
+    cone face around its apex (the loops' total winding number about the axis is not 0
+    and the apex is no vertex of the face, see :data:`APEX_AT_BOUNDARY`). No trimmed
+    face can carry such a point (OpenCascade marks it with a degenerate edge inside the
+    face, openNURBS refuses a singular trim off the domain's sides), and it is never
+    what a boundary that fits nothing simpler means: nearly flat free-form loops fit
+    wide cones around their apex, nearly spherical ones tori of almost no major radius.
+    A cone ending at its apex (a pin's point) and a band between two circles (winding
+    0) are kept."""
+    if s.kind == "torus":
+        return s.minor >= s.radius
+    if s.kind != "cone" or not np.tan(s.minor) > DIVISION_GUARD:
+        return False
+    apex = s.origin - (s.radius / np.tan(s.minor)) * s.axis
+    z = (np.asarray(p) - apex) @ s.axis / np.cos(s.minor)   # along the rulings
+    if z.min() < -tol and z.max() > tol:
+        return True
+    ext = float(np.linalg.norm(np.ptp(p, axis=0)))
+    if loops is None or np.linalg.norm(p - apex, axis=1).min() <= APEX_AT_BOUNDARY * ext:
+        return False
+    e1 = s.xdir
+    e2 = np.cross(s.axis, e1)
+    turns = 0.0
+    for lp in loops:
+        d = np.asarray(lp, np.float64) - apex
+        a = np.arctan2(d @ e2, d @ e1)
+        step = np.diff(np.r_[a, a[:1]])
+        turns += float(np.sum((step + np.pi) % (2 * np.pi) - np.pi)) / (2 * np.pi)
+    return round(turns) != 0

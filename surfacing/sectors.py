@@ -261,12 +261,13 @@ def analytic_faces(curves, boundaries, *, tol: float = ANALYTIC_TOL, flat=None, 
     list of AnalyticSurface or None
         Per patch; None for a free-form boundary.
     """
-    allpts = np.concatenate([np.asarray(c, float) for c in curves])
+    curves = [np.asarray(c, np.float64) for c in curves]
+    allpts = np.concatenate(curves)
     diag = float(np.linalg.norm(np.ptp(allpts, axis=0))) or 1.0
     out = []
     for k, b in enumerate(boundaries):
         ids = sorted({c for lp in b for c, _ in lp})
-        pts = [np.asarray(curves[c], np.float64) for c in ids]
+        pts = [curves[c] for c in ids]
         if flat is not None and flat[k]:
             p = np.concatenate(pts)
             n = np.asarray(normals[k], np.float64)
@@ -277,7 +278,8 @@ def analytic_faces(curves, boundaries, *, tol: float = ANALYTIC_TOL, flat=None, 
             e = e - (e @ n) * n
             out.append(AnalyticSurface("plane", o, n, e / np.linalg.norm(e), 0.0, 0.0, res))
             continue
-        out.append(fit_analytic(pts, tol=tol * diag, diagonal=diag))
+        loops = [loop_points(curves, lp) for lp in b]
+        out.append(fit_analytic(pts, tol=tol * diag, diagonal=diag, loops=loops))
     return out
 
 

@@ -87,6 +87,62 @@ def test_huge_radii_are_refused():
     assert fit_analytic(curves, tol=1e-9, diagonal=1.5, kinds=("cylinder",)) is None
 
 
+
+def _cone_loop(semi, drawn):
+    """A closed, non-planar loop once around the apex of a cone of semi-angle ``semi``
+    (apex at the origin, axis z), split in four curves as a network gives it: half of it
+    a circle about the axis when ``drawn``, else free-form all round."""
+    t = np.linspace(0, 2 * np.pi, 129)
+    rho = 1.0 + 0.3 * np.sin(t) ** 2 * (t > np.pi if drawn else 1.0 + np.cos(t) / 3)
+    loop = np.c_[rho * np.cos(t), rho * np.sin(t), rho / np.tan(semi)]
+    return [loop[i:i + 33] for i in range(0, 128, 32)], loop[:-1]
+
+
+def test_a_free_form_loop_near_a_cone_is_no_cone():
+    # a nearly flat free-form loop lies on a wide cone through no circle, ruling or apex
+    curves, _ = _cone_loop(np.radians(89.5), drawn=False)
+    assert fit_analytic(curves, tol=1e-9, diagonal=3.0, kinds=("cone",)) is None
+
+
+def test_a_cone_face_around_its_apex_is_refused_given_its_loops():
+    # the face inside the loop holds the apex, which no trimmed face can carry
+    curves, loop = _cone_loop(np.radians(60.0), drawn=True)
+    s = fit_analytic(curves, tol=1e-9, diagonal=3.0, kinds=("cone",))
+    assert s is not None and s.kind == "cone"           # the boundary alone lies on it
+    assert fit_analytic(curves, tol=1e-9, diagonal=3.0, kinds=("cone",), loops=[loop]) is None
+
+
+def test_a_cone_band_and_a_cone_ending_at_its_apex_are_kept_given_their_loops():
+    curves = FACES["cone"][0]
+    top, bottom, seam = curves
+    band = np.concatenate([top[:-1], seam[:-1], bottom[::-1][:-1], seam[::-1][:-1]])
+    s = fit_analytic(curves, tol=1e-9, diagonal=3.0, loops=[band])
+    assert s is not None and s.kind == "cone"           # winding 0 about the axis
+    # a pin's point: the base circle and a seam to the apex
+    apex_seam = _line((0.5, 0, 0), (0, 0, -1))
+    point = np.concatenate([bottom[:-1], apex_seam[:-1], apex_seam[::-1][:-1]])
+    s = fit_analytic([bottom, apex_seam], tol=1e-9, diagonal=3.0, kinds=("cone",),
+                     loops=[point])
+    assert s is not None and s.kind == "cone"
+
+
+def _torus_patch(major):
+    """Two meridian arcs (80 degrees apart) and two parallels of a torus of minor radius 1."""
+    a = np.linspace(-1.0, 1.0, 17)
+    phi = np.radians(np.linspace(0, 80, 17))
+    meridian = np.c_[major + np.cos(a), 0 * a, np.sin(a)]
+    turn = Rotation.from_euler("z", 80, degrees=True).apply(meridian)
+    rho = major + np.cos(1.0)
+    par = np.c_[rho * np.cos(phi), rho * np.sin(phi), np.full(17, np.sin(1.0))]
+    return [meridian, turn, par, par * [1, 1, -1]]
+
+
+def test_a_torus_that_crosses_itself_is_refused():
+    # a spindle torus (major radius 0.3 < minor 1) holds singular points on its axis
+    got = fit_analytic(_torus_patch(3.0), tol=1e-9, diagonal=8.0, kinds=("torus",))
+    assert got is not None and got.radius == pytest.approx(3.0, rel=1e-9)
+    assert fit_analytic(_torus_patch(0.3), tol=1e-9, diagonal=3.0, kinds=("torus",)) is None
+
 @pytest.mark.parametrize("name", ["cylinder", "cone", "sphere", "torus"])
 def test_projection_lands_on_the_surface_and_is_closest(name):
     curves, _ = FACES[name]
