@@ -219,6 +219,19 @@ def _domain_of(surface, k: int) -> tuple:
     return min(d.T0, d.T1), max(d.T0, d.T1)
 
 
+def _close_ends(curve) -> None:
+    """A 3D curve whose edge starts and ends at one vertex made closed: its end control
+    points (the ends of a clamped curve) moved to their mean. Its ends meet within the
+    vertex's tolerance only, and openNURBS wants such an edge's curve closed."""
+    import rhino3dm
+    n = len(curve.Points)
+    a, b = curve.Points[0], curve.Points[n - 1]
+    m = [0.5 * (a.X / a.W + b.X / b.W), 0.5 * (a.Y / a.W + b.Y / b.W),
+         0.5 * (a.Z / a.W + b.Z / b.W)]
+    curve.Points[0] = rhino3dm.Point4d(m[0] * a.W, m[1] * a.W, m[2] * a.W, a.W)
+    curve.Points[n - 1] = rhino3dm.Point4d(m[0] * b.W, m[1] * b.W, m[2] * b.W, b.W)
+
+
 def _close_loop(curves) -> None:
     """Make consecutive trims of a loop meet exactly: each junction's end control points
     (the ends of clamped curves) moved to their mean (sewn faces' curves on the surface
@@ -251,22 +264,69 @@ def _singular_lines(c2, trims, tis) -> None:
         trims[t]["dom"] = _domain(line)
 
 
+def _side_gap(uv, surface) -> tuple:
+    """``(gap, k, t)``: the side ``u`` (``k = 0``) or ``v`` (``k = 1``) ``= t`` of the
+    surface's domain nearest to a trim's control points ``uv`` (k, 2), and their largest
+    distance to it as a fraction of the domain's extent in that direction."""
+    off = []
+    for k in (0, 1):
+        t0, t1 = _domain_of(surface, k)
+        off += [(float(np.abs(uv[:, k] - t).max()) / (t1 - t0), k, t) for t in (t0, t1)]
+    return min(off)
+
+
+def _poles_only(items, surface) -> list:
+    """A loop's ``(edge, edge index, trim curve)`` items less the degenerate edges
+    (index -1) that are no pole or apex: those off the domain's sides (healing closes a
+    gap with one inside a face) and those whose neighbours already meet (a point between
+    two trims). openNURBS takes a singular trim only along a collapsed side; without
+    them the neighbours' ends are made to meet (:func:`_close_loop`)."""
+    ends = [(_control_uv(c)[0], _control_uv(c)[-1]) for _, _, c in items]
+    keep = []
+    for k, (e, ei, c) in enumerate(items):
+        if ei < 0:
+            prev_end, next_start = ends[k - 1][1], ends[(k + 1) % len(items)][0]
+            (s0, s1), (t0, t1) = (_domain_of(surface, d) for d in (0, 1))
+            span = np.abs(next_start - prev_end) / [s1 - s0, t1 - t0]
+            if _side_gap(_control_uv(c), surface)[0] > _SIDE_SNAP or span.max() <= _SIDE_SNAP:
+                continue
+        keep.append((e, ei, c))
+    return keep
+
+
+def _wire_edges(wire, face) -> list:
+    """The oriented edges of a wire in walking order: ``BRepTools_WireExplorer``'s, or the
+    wire's own order where the explorer stops early (it gives up at a degenerate edge
+    that healing put inside a face, and the loop's other edges would be lost)."""
+    from OCP.BRepTools import BRepTools_WireExplorer
+    from OCP.TopAbs import TopAbs_EDGE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+    walked, we = [], BRepTools_WireExplorer(wire, face)
+    while we.More():
+        walked.append(we.Current())
+        we.Next()
+    own, ex = [], TopExp_Explorer(wire, TopAbs_EDGE)
+    while ex.More():
+        own.append(TopoDS.Edge(ex.Current()))
+        ex.Next()
+    return walked if len(walked) == len(own) else own
+
+
 def _seams_on_sides(c2, trims, tis, surface) -> None:
     """Seam and singular trims' curves put exactly on the side of the domain they run
     along, and the neighbouring trims' ends onto their ends: openNURBS wants their
     ``m_iso`` to be a side, and near the ends of a B-spline piece's domain its tolerance
     is the end span's (NURBS conversion and the loop's closing leave them a hair off)."""
     import rhino3dm
-    bounds = [_domain_of(surface, k) for k in (0, 1)]
     for k, t in enumerate(tis):
         if not (trims[t]["seam"] or trims[t]["ei"] < 0):
             continue
         c = c2[trims[t]["c2i"]]
         uv = _control_uv(c)
-        off = [(np.abs(uv[:, d] - b).max(), d, b) for d in (0, 1) for b in bounds[d]]
-        gap, d, b = min(off)
-        if gap > _SIDE_SNAP * (bounds[d][1] - bounds[d][0]):   # not on a side: leave it
-            continue
+        gap, d, b = _side_gap(uv, surface)
+        if gap > _SIDE_SNAP and trims[t]["ei"] >= 0:    # a seam off the sides: leave it
+            continue        # (a singular trim was on its side before the loop was closed)
         uv[:, d] = b
         for i in range(len(uv)):
             w = c.Points[i].W
@@ -300,7 +360,7 @@ def brep_bytes(shape, tolerance: float) -> bytes:
     """
     from OCP.BRep import BRep_Tool
     from OCP.BRepBuilderAPI import BRepBuilderAPI_NurbsConvert
-    from OCP.BRepTools import BRepTools, BRepTools_WireExplorer
+    from OCP.BRepTools import BRepTools
     from OCP.GeomConvert import GeomConvert
     from OCP.TopAbs import TopAbs_EDGE, TopAbs_FACE, TopAbs_FORWARD, TopAbs_REVERSED, TopAbs_VERTEX
     from OCP.TopAbs import TopAbs_WIRE
@@ -324,6 +384,8 @@ def brep_bytes(shape, tolerance: float) -> bytes:
             continue
         curve = _on_curve(_bspline3d(e), 3)
         vi = [V.FindIndex(TopExp.FirstVertex_s(e)) - 1, V.FindIndex(TopExp.LastVertex_s(e)) - 1]
+        if vi[0] == vi[1]:
+            _close_ends(curve)
         edge_of[i - 1] = len(edges)
         c3.append(curve)
         edges.append({"vi": vi, "ti": [], "dom": _domain(curve)})
@@ -342,12 +404,10 @@ def brep_bytes(shape, tolerance: float) -> bytes:
         lis = []
         for w in wires:
             li, tis = len(loops), []
-            we = BRepTools_WireExplorer(w, face)
-            while we.More():
-                e = we.Current()
-                ei = edge_of.get(E.FindIndex(e) - 1, -1)
+            items = [(e, edge_of.get(E.FindIndex(e) - 1, -1), _on_curve(_bspline2d(e, face), 2))
+                     for e in _wire_edges(w, face)]
+            for e, ei, curve in _poles_only(items, surfaces[-1]):
                 rev = e.Orientation() == TopAbs_REVERSED
-                curve = _on_curve(_bspline2d(e, face), 2)
                 seam = BRep_Tool.IsClosed_s(e, face)
                 ti = len(trims)
                 if ei < 0:
@@ -359,7 +419,6 @@ def brep_bytes(shape, tolerance: float) -> bytes:
                               "seam": seam, "li": li, "dom": _domain(curve)})
                 c2.append(curve)
                 tis.append(ti)
-                we.Next()
             _singular_lines(c2, trims, tis)
             _close_loop([c2[trims[t]["c2i"]] for t in tis])
             _seams_on_sides(c2, trims, tis, surfaces[-1])

@@ -224,6 +224,21 @@ def test_3dm_trims_near_the_sides_of_pieces_get_the_flags_opennurbs_computes(tmp
     assert len(breps) == 3 and all(b.IsValid for b in breps)
 
 
+
+def test_3dm_loops_keep_every_edge_past_a_degenerate_one_healing_put_in(tmp_path, data_dir):
+    """Healing closes a gap in one of the submarine's loops with a degenerate edge that
+    is no pole; ``BRepTools_WireExplorer`` stopped there and the loop lost five of its
+    eight edges ("trim vertex mismatch"). The wire's own order is walked instead and
+    the degenerate edge is left out; the pole trims left are put on their sides."""
+    pytest.importorskip("rhino3dm")
+    pytest.importorskip("OCP")
+    from curvenet import cad
+    res = surface(data_dir / "networks" / "mingzou" / "SGA_Submarine.obj", method="classical",
+                  classical_options={"subdiv": 1})
+    res.save(tmp_path / "s.3dm")
+    breps = cad.read_3dm_breps(tmp_path / "s.3dm")
+    assert len(breps) == 3 and all(b.IsValid for b in breps)
+
 def test_tori_go_to_3dm_as_their_pieces_when_the_nurbs_conversion_refuses(tmp_path,
                                                                         monkeypatch):
     """OpenCascade's torus-to-NURBS conversion raises on some sewn trimmed tori (a
