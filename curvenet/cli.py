@@ -193,7 +193,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--resolution", type=_positive_int, help="Coons samples per side segment")
     s.add_argument("--crease-angle", type=float, default=30.0, metavar="DEG")
     s.add_argument("--refine", action="store_true",
-                   help="continue the classical result with the neural flow-alignment fit")
+                   help="continue the classical result with the neural flow-alignment fit "
+                        "(closer to the strokes as drawn, not to the true shape)")
     s.add_argument("--quality", choices=("draft", "default", "paper"), default="draft")
     s.add_argument("--device", default="cpu", help="cpu or cuda (neural route)")
     s.add_argument("--closed-box", action="store_true",
