@@ -209,35 +209,27 @@ def test_3dm_is_one_joined_closed_brep(tmp_path, make):
                                               "solids": 1, "valid": True, "wires": 0}
 
 
-def test_3dm_trims_near_the_sides_of_pieces_get_the_flags_opennurbs_computes(tmp_path,
-                                                                          data_dir):
-    """B-spline pieces have knots refined toward their sides, and openNURBS scales its
-    parameter tolerance with the end span: a trim a hair off a side is no side iso there,
-    and a Brep whose ``m_iso`` flags disagree is invalid (the cup's three were)."""
+@pytest.mark.parametrize("stem, breps", [
+    # B-spline pieces have knots refined toward their sides, and openNURBS scales its
+    # parameter tolerance with the end span: a trim a hair off a side is no side iso
+    # there, and a Brep whose m_iso flags disagree is invalid (the cup's three were)
+    ("cup", 3),
+    # healing closes a gap in one of the submarine's loops with a degenerate edge that
+    # is no pole; BRepTools_WireExplorer stopped there and the loop lost five of its
+    # eight edges ("trim vertex mismatch"): the wire's own order is walked instead, the
+    # degenerate edge left out and the pole trims left put on their sides
+    ("SGA_Submarine", 3),
+])
+def test_3dm_of_public_networks_is_valid(tmp_path, data_dir, stem, breps):
     pytest.importorskip("rhino3dm")
     pytest.importorskip("OCP")
     from curvenet import cad
-    res = surface(data_dir / "networks" / "mingzou" / "cup.obj", method="classical",
+    res = surface(data_dir / "networks" / "mingzou" / f"{stem}.obj", method="classical",
                   classical_options={"subdiv": 1})
     res.save(tmp_path / "c.3dm")
-    breps = cad.read_3dm_breps(tmp_path / "c.3dm")
-    assert len(breps) == 3 and all(b.IsValid for b in breps)
+    got = cad.read_3dm_breps(tmp_path / "c.3dm")
+    assert len(got) == breps and all(b.IsValid for b in got)
 
-
-
-def test_3dm_loops_keep_every_edge_past_a_degenerate_one_healing_put_in(tmp_path, data_dir):
-    """Healing closes a gap in one of the submarine's loops with a degenerate edge that
-    is no pole; ``BRepTools_WireExplorer`` stopped there and the loop lost five of its
-    eight edges ("trim vertex mismatch"). The wire's own order is walked instead and
-    the degenerate edge is left out; the pole trims left are put on their sides."""
-    pytest.importorskip("rhino3dm")
-    pytest.importorskip("OCP")
-    from curvenet import cad
-    res = surface(data_dir / "networks" / "mingzou" / "SGA_Submarine.obj", method="classical",
-                  classical_options={"subdiv": 1})
-    res.save(tmp_path / "s.3dm")
-    breps = cad.read_3dm_breps(tmp_path / "s.3dm")
-    assert len(breps) == 3 and all(b.IsValid for b in breps)
 
 def test_tori_go_to_3dm_as_their_pieces_when_the_nurbs_conversion_refuses(tmp_path,
                                                                         monkeypatch):
