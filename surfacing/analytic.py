@@ -465,6 +465,13 @@ def fit_analytic(curves, *, tol: float, diagonal: float, kinds=KINDS, loops=None
     return None
 
 
+def _apex(s: AnalyticSurface):
+    """A cone's apex (3,), or None for a semi-angle too small to place it."""
+    if not np.tan(s.minor) > DIVISION_GUARD:
+        return None
+    return s.origin - (s.radius / np.tan(s.minor)) * s.axis
+
+
 def _drawn_cone(s: AnalyticSurface, curves, tol: float) -> bool:
     """Whether a cone's boundary holds one of the curves a cone face is drawn with: a
     circle about its axis (a chamfer's or countersink's rim), a ruling (a line through
@@ -472,7 +479,9 @@ def _drawn_cone(s: AnalyticSurface, curves, tol: float) -> bool:
     to lie within the tolerance of some cone is a free-form face: nearly flat ones fit
     wide cones (semi-angles near 90 degrees) whose apex the face's curves on the
     surface wander across."""
-    apex = s.origin - (s.radius / np.tan(s.minor)) * s.axis
+    apex = _apex(s)
+    if apex is None:
+        return False
     for c in curves:
         if np.linalg.norm(c[[0, -1]] - apex, axis=1).min() <= tol:
             return True
@@ -514,9 +523,9 @@ def _through_singularity(s: AnalyticSurface, p, tol: float, loops=None) -> bool:
     0) are kept."""
     if s.kind == "torus":
         return s.minor >= s.radius
-    if s.kind != "cone" or not np.tan(s.minor) > DIVISION_GUARD:
+    apex = _apex(s) if s.kind == "cone" else None
+    if apex is None:
         return False
-    apex = s.origin - (s.radius / np.tan(s.minor)) * s.axis
     z = (np.asarray(p) - apex) @ s.axis / np.cos(s.minor)   # along the rulings
     if z.min() < -tol and z.max() > tol:
         return True

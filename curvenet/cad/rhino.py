@@ -219,30 +219,17 @@ def _domain_of(surface, k: int) -> tuple:
     return min(d.T0, d.T1), max(d.T0, d.T1)
 
 
-def _close_ends(curve) -> None:
-    """A 3D curve whose edge starts and ends at one vertex made closed: its end control
-    points (the ends of a clamped curve) moved to their mean. Its ends meet within the
-    vertex's tolerance only, and openNURBS wants such an edge's curve closed."""
-    import rhino3dm
-    n = len(curve.Points)
-    a, b = curve.Points[0], curve.Points[n - 1]
-    m = [0.5 * (a.X / a.W + b.X / b.W), 0.5 * (a.Y / a.W + b.Y / b.W),
-         0.5 * (a.Z / a.W + b.Z / b.W)]
-    curve.Points[0] = rhino3dm.Point4d(m[0] * a.W, m[1] * a.W, m[2] * a.W, a.W)
-    curve.Points[n - 1] = rhino3dm.Point4d(m[0] * b.W, m[1] * b.W, m[2] * b.W, b.W)
-
-
 def _close_loop(curves) -> None:
-    """Make consecutive trims of a loop meet exactly: each junction's end control points
-    (the ends of clamped curves) moved to their mean (sewn faces' curves on the surface
-    meet within the sewing tolerance only; openNURBS wants them to meet)."""
+    """Make consecutive curves of a loop meet exactly: each junction's end control points
+    (the ends of clamped curves) moved to their mean. Trims of a loop (sewn faces' curves
+    on the surface meet within the sewing tolerance only) and, as a loop of one, a 3D
+    edge curve that starts and ends at one vertex: openNURBS wants them to meet."""
     import rhino3dm
     for a, b in zip(curves, curves[1:] + curves[:1]):
         pa, pb = a.Points[len(a.Points) - 1], b.Points[0]
-        x = 0.5 * (pa.X / pa.W + pb.X / pb.W)
-        y = 0.5 * (pa.Y / pa.W + pb.Y / pb.W)
-        a.Points[len(a.Points) - 1] = rhino3dm.Point4d(x * pa.W, y * pa.W, 0.0, pa.W)
-        b.Points[0] = rhino3dm.Point4d(x * pb.W, y * pb.W, 0.0, pb.W)
+        x, y, z = (0.5 * (getattr(pa, k) / pa.W + getattr(pb, k) / pb.W) for k in "XYZ")
+        a.Points[len(a.Points) - 1] = rhino3dm.Point4d(x * pa.W, y * pa.W, z * pa.W, pa.W)
+        b.Points[0] = rhino3dm.Point4d(x * pb.W, y * pb.W, z * pb.W, pb.W)
 
 
 def _singular_lines(c2, trims, tis) -> None:
@@ -281,14 +268,13 @@ def _poles_only(items, surface) -> list:
     gap with one inside a face) and those whose neighbours already meet (a point between
     two trims). openNURBS takes a singular trim only along a collapsed side; without
     them the neighbours' ends are made to meet (:func:`_close_loop`)."""
-    ends = [(_control_uv(c)[0], _control_uv(c)[-1]) for _, _, c in items]
+    uv = [_control_uv(c) for _, _, c in items]
+    extent = np.array([b - a for a, b in (_domain_of(surface, d) for d in (0, 1))])
     keep = []
     for k, (e, ei, c) in enumerate(items):
         if ei < 0:
-            prev_end, next_start = ends[k - 1][1], ends[(k + 1) % len(items)][0]
-            (s0, s1), (t0, t1) = (_domain_of(surface, d) for d in (0, 1))
-            span = np.abs(next_start - prev_end) / [s1 - s0, t1 - t0]
-            if _side_gap(_control_uv(c), surface)[0] > _SIDE_SNAP or span.max() <= _SIDE_SNAP:
+            span = np.abs(uv[(k + 1) % len(items)][0] - uv[k - 1][-1]) / extent
+            if _side_gap(uv[k], surface)[0] > _SIDE_SNAP or span.max() <= _SIDE_SNAP:
                 continue
         keep.append((e, ei, c))
     return keep
@@ -385,7 +371,7 @@ def brep_bytes(shape, tolerance: float) -> bytes:
         curve = _on_curve(_bspline3d(e), 3)
         vi = [V.FindIndex(TopExp.FirstVertex_s(e)) - 1, V.FindIndex(TopExp.LastVertex_s(e)) - 1]
         if vi[0] == vi[1]:
-            _close_ends(curve)
+            _close_loop([curve])
         edge_of[i - 1] = len(edges)
         c3.append(curve)
         edges.append({"vi": vi, "ti": [], "dom": _domain(curve)})
