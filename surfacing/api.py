@@ -21,19 +21,20 @@ from .controlmesh import build_control_mesh
 from .sharp import DEFAULT_CREASE_ANGLE, sharp_structure
 from .curveupdate import fit_cubic_curve
 from .fit import (FAIRNESS, LAMBDA, VSPRING_STEP, bending_energy, fairness_matrix,
-                  fit_iterative, fit_lsq, variation_matrix)
+                  fit_iterative, fit_lsq, swept_rows, variation_matrix)
 from .limit import limit_matrix, tangent_matrices
 from .polyline import point_polyline_distance
 from .sides import DEFAULT_STRAIGHT_ANGLE
 from .soap import soapfilm_mesh
 
 __all__ = ["PatchMeshResult", "surface_loops", "soapfilm_loops", "check_loops_options",
-           "FITS", "AUTO_FIT_MAX_VERTICES", "AUTO_FIT_MAX_ITER", "DEFAULT_RESOLUTION",
-           "DEFAULT_SUBDIV", "DEFAULT_TOL",
-           "DEFAULT_EDGE_LENGTH", "DEFAULT_MAX_FACES", "density_subdiv"]
+           "FITS", "AUTO_FIT_MAX_VERTICES", "AUTO_FIT_MAX_ITER", "AUTO_FIT_MAX_LEVEL_VERTICES",
+           "AUTO_FIT_TIE", "AUTO_FIT_PREFERENCE", "DEFAULT_RESOLUTION", "DEFAULT_SUBDIV",
+           "DEFAULT_TOL", "DEFAULT_EDGE_LENGTH", "DEFAULT_MAX_FACES", "density_subdiv"]
 
-#: Fits of :func:`surface_loops`: ``auto`` (both below, the fairer kept), ``lsq``, ``iterative``.
-FITS = ("auto", "lsq", "iterative")
+#: Fits of :func:`surface_loops`: ``auto`` (those below, the fairest kept), ``lsq``,
+#: ``sweep``, ``iterative``.
+FITS = ("auto", "lsq", "sweep", "iterative")
 #: ``fit="auto"`` tries the published iteration on control nets of at most this many
 #: vertices (sparse networks, where the fairness energy, not the curves, decides the
 #: shape between curves); larger nets take the least-squares fit alone.
@@ -41,8 +42,20 @@ AUTO_FIT_MAX_VERTICES = 500
 #: Steps ``auto`` gives the iteration: where it was kept it converged in 36-165 steps; one
 #: that has not by then is not taken (and would cost up to ``max_iter`` steps per fit).
 AUTO_FIT_MAX_ITER = 250
-#: Catmull-Clark level of the limit meshes whose bending energies ``auto`` compares.
-AUTO_FIT_LEVEL = 2
+#: Catmull-Clark level of the limit meshes whose bending energies ``auto`` compares ...
+#: Level 1: at finer levels the limit surface resolves the wiggle of rough or recovered
+#: curves, which every fit interpolates, and that energy drowns the difference between
+#: the fits' shapes (a torus from point samples: the swept fit 66.6 / 109.9 / 137.8 at
+#: levels 1 / 2 / 3, the flattened least-squares fit 85.9 / 108.3 / 122.6).
+AUTO_FIT_LEVEL = 1
+#: ... lowered (to 0 at the least) until that mesh has at most this many vertices.
+AUTO_FIT_MAX_LEVEL_VERTICES = 100_000
+#: Bending energies within this fraction of the least are a tie: the energy of a coarse
+#: limit mesh is a few percent off its limit (tori, rough and drawn through: 1-3% at
+#: level 1), and two fits' order can flip between levels within such a band.
+AUTO_FIT_TIE = 0.01
+#: Who wins a tie: the swept shape the drawn sections imply, then the least-squares fit.
+AUTO_FIT_PREFERENCE = ("sweep", "lsq", "iterative")
 #: Control-polygon segments per curve (the paper's user-set N).
 DEFAULT_RESOLUTION = 4
 #: Catmull-Clark levels of the output mesh.
@@ -218,21 +231,25 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
         above ``crease_angle`` degrees become creases too (None: labelled ones only).
     resolution : int
         Control-polygon segments per curve piece (>= 2, odd rounded up to even); long
-        or winding curves get several pieces (:func:`surfacing.controlmesh.curve_pieces`).
+        or winding curves get several pieces (:func:`surfacing.pieces.curve_pieces`).
     subdiv : int or None
         Catmull-Clark levels for the output mesh (>= 0); None chooses the level from
         ``edge_length`` (see :func:`density_subdiv`, at most :data:`DEFAULT_MAX_FACES`
         triangles).
     edge_length : float
         Target output edge length, fraction of the diagonal, when ``subdiv`` is None.
-    fit : {"auto", "lsq", "iterative"}
+    fit : {"auto", "lsq", "sweep", "iterative"}
         ``lsq``: direct sparse least squares with exact interpolation of the curve
-        samples; ``iterative``: the published iteration (Eq. 3 with V-spring, Eq. 4);
-        ``auto`` (default): ``lsq``, and on control nets of at most
-        :data:`AUTO_FIT_MAX_VERTICES` vertices also ``iterative`` (when it reaches
-        ``tol`` within :data:`AUTO_FIT_MAX_ITER` steps, then corrected to interpolate
-        the samples exactly by the change of least fairness energy), keeping the one
-        whose limit surface bends less (:func:`surfacing.fit.bending_energy`).
+        samples; ``sweep``: the same, its fairness measured from the swept shape of
+        the four-sided loops (:mod:`surfacing.sweep`), which it keeps between the
+        curves; ``iterative``: the published iteration (Eq. 3 with V-spring, Eq. 4);
+        ``auto`` (default): ``lsq`` and ``sweep`` (one factorisation), and on control
+        nets of at most :data:`AUTO_FIT_MAX_VERTICES` vertices also ``iterative``
+        (when it reaches ``tol`` within :data:`AUTO_FIT_MAX_ITER` steps, then
+        corrected to interpolate the samples exactly by the change of least fairness
+        energy), keeping the one whose limit surface bends least
+        (:func:`surfacing.fit.bending_energy`; within :data:`AUTO_FIT_TIE` of the least,
+        the first of :data:`AUTO_FIT_PREFERENCE`).
     update_curves : bool or iterable of int
         Return curves refitted to the surface (Sec. 4.3.3): all when True, else the
         given indices (the others are returned unchanged).
@@ -321,8 +338,9 @@ def _fit_control_net(cm, sharp, *, fit, fairness, curve_weight, lam, tol, max_it
 
     Returns ``(P (n, 3) float64, iterations, sample deviations (k,) float64, choice)``:
     ``choice`` is the fit used and, for ``auto``, the bending energy of each fit tried
-    (``{"fit": ..., "energy": {"lsq": e, "iterative": e or None}}``; None: the iteration
-    did not reach ``tol`` within its steps).
+    (``{"fit": ..., "energy": {"lsq": e, "sweep": e or None, "iterative": e or None}}``;
+    None: not tried: no swept loop, a control net too large for the iteration, or
+    an iteration that did not reach ``tol`` within its steps).
     """
     t0 = time.perf_counter()
     sharp_edges, corners = sharp
@@ -331,42 +349,78 @@ def _fit_control_net(cm, sharp, *, fit, fairness, curve_weight, lam, tol, max_it
     cons = np.flatnonzero(cm.on_curve)
     targets = cm.target[cons]
     diag = cm.diagonal if cm.diagonal > 0 else 1.0
-    F = None
-    if fit != "iterative":      # the fairness of lsq and of auto's exact-interpolation step
-        F = fairness_matrix(cm.quads, n, sharp_edges, corners)
-        if fairness == "variation":
-            F = variation_matrix(F)
-
-    def lsq():
-        return fit_lsq(L, F, cm.vertices, cons, targets, curve_weight=curve_weight), 1
-
-    def iterative(steps):
-        T1, T2, has = tangent_matrices(cm.quads, n, sharp_edges, corners)
-        P, iters, _ = fit_iterative(L, T1, T2, has, cm.quads, cm.vertices, cons, targets,
-                                    lam=lam, tol=tol * diag, max_iter=steps,
-                                    sharp_edges=sharp_edges, corners=corners,
-                                    vspring_step=vspring_step)
-        return P, iters
-
-    choice = {"fit": fit}
     if fit == "iterative":
-        P, iters = iterative(max_iter)
-    else:
-        P, iters = lsq()
-    if fit == "auto":
-        choice = {"fit": "lsq", "energy": {"lsq": None, "iterative": None}}
-        if curve_weight is None and n <= AUTO_FIT_MAX_VERTICES:
-            steps = min(max_iter, AUTO_FIT_MAX_ITER)
-            Pi, it_i = iterative(steps)
-            if it_i < steps:            # reached tol; then the least fair change that
-                # makes it interpolate the samples exactly, as the lsq fit does
-                Pi = Pi + fit_lsq(L, F, np.zeros_like(Pi), cons, targets - (L @ Pi)[cons])
-                energy = {name: bending_energy(*_limit_surface(Q, cm, sharp, AUTO_FIT_LEVEL,
-                                                               {})[:2])
-                          for name, Q in (("lsq", P), ("iterative", Pi))}
-                choice["energy"] = energy
-                if energy["iterative"] < energy["lsq"]:
-                    P, iters, choice["fit"] = Pi, it_i, "iterative"
+        P, iters = _iterate(cm, sharp, L, cons, targets, lam=lam, tol=tol * diag,
+                            steps=max_iter, vspring_step=vspring_step)
+        return _fitted(P, iters, L, cons, targets, {"fit": fit}, timings, t0)
+    F = fairness_matrix(cm.quads, n, sharp_edges, corners)
+    if fairness == "variation":
+        F = variation_matrix(F)
+    goals = {"lsq": None}
+    if fit in ("sweep", "auto") and cm.swept is not None and cm.swept.any():
+        rows = swept_rows(F, cm.quads, cm.face_patch, cm.swept)
+        if rows.any():
+            # the limit of a control net lies inside it: one step of the inverse,
+            # R + (R - L R), puts the rest net's limit on the swept shape to second order
+            rest = 2.0 * cm.rest - L @ cm.rest
+            goals["sweep"] = np.where(rows[:, None], F @ rest, 0.0)
+    if fit == "lsq":
+        goals.pop("sweep", None)
+    elif fit == "sweep" and "sweep" in goals:
+        goals.pop("lsq")
+    fits = dict(zip(goals, fit_lsq(L, F, cm.vertices, cons, targets, curve_weight=curve_weight,
+                                   goals=list(goals.values()))))
+    if fit != "auto":
+        name = next(iter(fits))
+        return _fitted(fits[name], 1, L, cons, targets, {"fit": name}, timings, t0)
+    iters = {name: 1 for name in fits}
+    if curve_weight is None and n <= AUTO_FIT_MAX_VERTICES:
+        steps = min(max_iter, AUTO_FIT_MAX_ITER)
+        Pi, it_i = _iterate(cm, sharp, L, cons, targets, lam=lam, tol=tol * diag,
+                            steps=steps, vspring_step=vspring_step)
+        if it_i < steps:            # reached tol; then the least fair change that
+            # makes it interpolate the samples exactly, as the lsq fit does
+            fits["iterative"] = Pi + fit_lsq(L, F, np.zeros_like(Pi), cons,
+                                             targets - (L @ Pi)[cons])
+            iters["iterative"] = it_i
+    energy = {"lsq": None, "sweep": None, "iterative": None}
+    if len(fits) > 1:
+        level = _energy_level(cm)
+        energy.update({name: bending_energy(*_limit_surface(Q, cm, sharp, level, {})[:2])
+                       for name, Q in fits.items()})
+    best = next(iter(fits))
+    judged = [name for name in AUTO_FIT_PREFERENCE
+              if name in fits and energy[name] is not None and np.isfinite(energy[name])]
+    if judged:
+        least = min(energy[name] for name in judged)
+        best = next(name for name in judged if energy[name] <= least * (1.0 + AUTO_FIT_TIE))
+    return _fitted(fits[best], iters[best], L, cons, targets, {"fit": best, "energy": energy},
+                   timings, t0)
+
+
+def _iterate(cm, sharp, L, cons, targets, *, lam, tol, steps, vspring_step):
+    """The published iteration (Eq. 3-4) from the Coons control mesh: ``(P, iterations)``."""
+    sharp_edges, corners = sharp
+    n = len(cm.vertices)
+    T1, T2, has = tangent_matrices(cm.quads, n, sharp_edges, corners)
+    P, iters, _ = fit_iterative(L, T1, T2, has, cm.quads, cm.vertices, cons, targets,
+                                lam=lam, tol=tol, max_iter=steps, sharp_edges=sharp_edges,
+                                corners=corners, vspring_step=vspring_step)
+    return P, iters
+
+
+def _energy_level(cm) -> int:
+    """Catmull-Clark level of the meshes whose bending energies ``auto`` compares:
+    :data:`AUTO_FIT_LEVEL`, lowered while that mesh would exceed
+    :data:`AUTO_FIT_MAX_LEVEL_VERTICES` vertices (about ``4**level`` per control quad)."""
+    level = AUTO_FIT_LEVEL
+    while level > 0 and len(cm.quads) * 4 ** level > AUTO_FIT_MAX_LEVEL_VERTICES:
+        level -= 1
+    return level
+
+
+def _fitted(P, iters, L, cons, targets, choice, timings, t0):
+    """``_fit_control_net``'s return value, with the sample deviations and the time."""
     sample_dev = np.linalg.norm((L @ P)[cons] - targets, axis=1)
     timings["fit"] = time.perf_counter() - t0
     return P, iters, sample_dev, choice

@@ -2,7 +2,7 @@
 
 Every network curve is resampled into ``N`` equal-arc-length segments (``2 N`` for a
 closed curve, one whose two ends are the same junction; with ``adaptive`` a multiple
-of ``N`` for long or winding curves, see :func:`curve_pieces`), and the samples become
+of ``N`` for long or winding curves, see :func:`.pieces.curve_pieces`), and the samples become
 control vertices shared by every patch that uses the curve. Each loop is then filled
 with quads:
 
@@ -49,142 +49,16 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from .coons import coons_eval, coons_grid
-from curvenet.core.geometry import arc_length, arc_length_params, resample_polyline
+from curvenet.core.geometry import resample_polyline
 from curvenet.core.tolerances import DIVISION_GUARD
+from .pieces import curve_pieces, equalise_strips
 from .sides import DEFAULT_STRAIGHT_ANGLE, group_sides
+from .sweep import sweep_grid
 
-__all__ = ["ControlMesh", "build_control_mesh", "orient_loops", "curve_pieces", "JUNCTION_TOL"]
+__all__ = ["ControlMesh", "build_control_mesh", "orient_loops", "JUNCTION_TOL"]
 
 #: Curve ends closer than this fraction of the bounding-box diagonal are one junction.
 JUNCTION_TOL = 1e-6
-#: Adaptive pieces: a curve gets one more piece of ``N`` segments per this many times the
-#: median curve length ...
-PIECE_LENGTH = 2.0
-#: ... and per this much turning (degrees) seen at the scale of the pieces ...
-PIECE_TURN = 120.0
-#: ... a scale of ``s`` pieces being the curve resampled at ``TURN_SEGMENTS * s``
-#: segments (twice the default resolution per piece), for ``s`` up to :data:`TURN_SCALES`
-#: (32 segments). A curve needs more than ``s`` pieces when it turns by more than
-#: ``PIECE_TURN * s`` at that scale. Seen only at 32 segments, the wobble of a hand-drawn
-#: 90 degree arc summed to 125 degrees (under 95 at 8), and one quad strip of a regular
-#: layout got twice the control points of its neighbours, which the fair fit turns into
-#: a bulge; seen only at 8, detail finer than a piece would be aliased away.
-TURN_SEGMENTS = 8
-TURN_SCALES = 4
-#: Ratios within this of an integer count as that integer (equal curves get equal pieces).
-PIECE_ROUNDING = 1e-9
-
-
-def _turning(curve: np.ndarray, n: int) -> float:
-    """Total turning (degrees) of ``curve`` resampled at ``n`` equal-arc segments.
-
-    Scaled by ``n / (n - 1)``: the ``n - 1`` joints of a circular arc's resample turn by
-    ``(n - 1) / n`` of its angle, so an arc measures its angle at any ``n``.
-    """
-    d = np.diff(resample_polyline(curve, n), axis=0)
-    d /= np.maximum(np.linalg.norm(d, axis=1, keepdims=True), DIVISION_GUARD)
-    return float(np.degrees(np.arccos(np.clip((d[1:] * d[:-1]).sum(1), -1, 1))).sum()
-                 * n / (n - 1))
-
-
-def _turnings(curves: list, n: int, params=None) -> np.ndarray:
-    """:func:`_turning` of many curves at once: ``(C,) float64``, bit for bit the same.
-
-    Parameters
-    ----------
-    curves : list of (m_i, 3) float64, m_i >= 2
-    n : int
-        Segments of the resample.
-    params : list of (m_i,) float64, optional
-        :func:`~curvenet.core.geometry.arc_length_params` of each curve (computed when
-        not given; pass them to share them between calls).
-
-    Notes
-    -----
-    Every curve is resampled at the same ``n + 1`` parameters, so the resamples stack
-    into one ``(C, n + 1, 3)`` array; only the segment lookup (one ``searchsorted``)
-    runs per curve. The arithmetic is elementwise and the sums run along contiguous
-    last axes, as in :func:`~curvenet.core.geometry.interpolate_polyline` and
-    :func:`_turning`.
-    """
-    if not curves:
-        return np.zeros(0)
-    params = [arc_length_params(c) for c in curves] if params is None else params
-    s = np.linspace(0.0, 1.0, int(n) + 1)
-    sizes = np.array([len(c) for c in curves], np.int64)
-    start = np.cumsum(sizes) - sizes
-    j = np.stack([np.clip(np.searchsorted(cum, np.clip(s, cum[0], cum[-1]), side="right") - 1,
-                          0, len(cum) - 2) for cum in params]) + start[:, None]   # (C, n + 1)
-    lo = np.stack([np.clip(s, cum[0], cum[-1]) for cum in params])             # (C, n + 1)
-    cum, pts = np.concatenate(params), np.concatenate(curves)
-    seg = cum[j + 1] - cum[j]
-    t = np.where(seg > 0, (lo - cum[j]) / np.where(seg > 0, seg, 1.0), 0.0)
-    r = pts[j] + t[..., None] * (pts[j + 1] - pts[j])                           # (C, n + 1, 3)
-    r[:, 0], r[:, -1] = pts[start], pts[start + sizes - 1]
-    d = np.diff(r, axis=1)                                                      # (C, n, 3)
-    d /= np.maximum(np.linalg.norm(d, axis=2, keepdims=True), DIVISION_GUARD)
-    turn = np.degrees(np.arccos(np.clip((d[:, 1:] * d[:, :-1]).sum(2), -1, 1)))  # (C, n - 1)
-    return turn.sum(1) * n / (n - 1)
-
-
-def _turns_pieces(curves: list) -> np.ndarray:
-    """Pieces each curve (``(m_i, 3)``, ``m_i >= 2``) asks for: ``(C,) int64``.
-
-    At scale ``s`` (1 .. TURN_SCALES) a curve is resampled at ``TURN_SEGMENTS * s``
-    segments; when it turns by more than ``PIECE_TURN * s`` there, ``s`` pieces cannot
-    follow it and the scale asks for ``ceil(turning / PIECE_TURN)``; otherwise it asks
-    for nothing (coarser scales decide whether fewer are enough). Stroke wobble below a
-    piece's scale therefore adds nothing to a curve that the coarse scales find smooth.
-    """
-    need = np.ones(len(curves), np.int64)
-    params = [arc_length_params(c) for c in curves]
-    for s in range(1, TURN_SCALES + 1):
-        t = _turnings(curves, TURN_SEGMENTS * s, params) / PIECE_TURN
-        over = t > s * (1 + PIECE_ROUNDING)
-        need[over] = np.maximum(need[over], np.ceil(t[over] - PIECE_ROUNDING).astype(np.int64))
-    return need
-
-
-def curve_pieces(curves: list, closed: np.ndarray) -> np.ndarray:
-    """Pieces (of ``N`` control segments each) per curve for adaptive resolution.
-
-    ``max(1, ceil(length / (PIECE_LENGTH * median length)), turning pieces)``, at least 2
-    for a closed curve; the turning pieces are what the curve's turning asks for at the
-    scales of one to :data:`TURN_SCALES` pieces (:func:`_turns_pieces`).
-
-    Returns
-    -------
-    (C,) int64
-    """
-    lengths = np.array([arc_length(c) for c in curves])
-    med = float(np.median(lengths)) if len(lengths) else 1.0
-    turn = _turns_pieces([np.asarray(c, dtype=np.float64) for c in curves])
-    # a curve exactly PIECE_LENGTH medians long (rounding noise aside) stays one piece
-    m = np.maximum(np.ceil(lengths / (PIECE_LENGTH * max(med, DIVISION_GUARD)) - PIECE_ROUNDING),
-                   turn)
-    m = np.maximum(m, 1).astype(np.int64)
-    return np.where(closed, np.maximum(m, 2), m)
-
-
-def _equalise_strips(m: np.ndarray, loops: list) -> np.ndarray:
-    """Raise piece counts so opposite curves of every four-curve loop agree.
-
-    Opposite curves of four-curve loops are joined into classes (the quad strips of
-    the layout); every curve of a class takes the class maximum, so those loops stay
-    regular ``p x q`` grids instead of falling back to a centre split.
-    """
-    C = len(m)
-    pairs = [(lp[k][0], lp[k + 2][0]) for lp in loops if len(lp) == 4 for k in (0, 1)]
-    if not pairs:
-        return m
-    pr = np.array(pairs, dtype=np.int64)
-    g = sp.coo_matrix((np.ones(len(pr)), (pr[:, 0], pr[:, 1])), shape=(C, C))
-    _, lab = connected_components(g, directed=False)
-    best = np.zeros(lab.max() + 1, dtype=np.int64)
-    np.maximum.at(best, lab, m)
-    return best[lab]
-
-
 @dataclass
 class ControlMesh:
     """A stitched quad control mesh.
@@ -209,6 +83,11 @@ class ControlMesh:
         ``"grid"``, ``"pieces4"``, ``"halves"``, ``"split-coons4"`` or ``"split"``.
     diagonal : float
         Bounding-box diagonal of all curve points.
+    rest : (n, 3) float64
+        The swept shape (:func:`.sweep.sweep_grid`) of the ``"grid"`` loops' vertices,
+        ``vertices`` elsewhere: the rest shape of the ``sweep`` fit.
+    swept : (L,) bool
+        Loops whose inside ``rest`` sweeps (the ``"grid"`` ones).
     """
 
     vertices: np.ndarray
@@ -222,6 +101,8 @@ class ControlMesh:
     loops: list
     patch_kind: list = field(default_factory=list)
     diagonal: float = 1.0
+    rest: np.ndarray | None = None
+    swept: np.ndarray | None = None
 
 
 def _validate(curves, loops):
@@ -417,20 +298,23 @@ def build_control_mesh(curves, loops, resolution: int = 4, *,
     jend, jpos = _junctions(curves, loops, diag)
     closed = jend[:, 0] == jend[:, 1]
     if adaptive:
-        k_c = N * _equalise_strips(curve_pieces(curves, closed), loops)
+        k_c = N * equalise_strips(curve_pieces(curves, closed), loops)
     else:
         k_c = N * np.where(closed, 2, 1)
     curve_pos, curve_vids, samples = _sample_curves(curves, jend, jpos, k_c)
     nid = n_curve_v = len(curve_pos)
     positions, quads_all, fpatch, kinds = [curve_pos], [], [], []
+    swept: dict = {}                # (p, q) -> [(block in positions, its four sides)]
     for j, lp in enumerate(loops):
         B, BP, starts, dense = _loop_boundary(lp, curves, curve_vids, samples)
         kind, p, q, roll, sides = _patch_layout(lp, dense, starts, k_c, N, len(B),
                                                 straight_angle)
         kinds.append(kind)
         if kind in ("grid", "pieces4", "halves"):
-            newpos, quads, nid = _grid_patch(np.roll(B, -roll), np.roll(BP, -roll, axis=0),
-                                             p, q, nid)
+            newpos, grid_sides, quads, nid = _grid_patch(np.roll(B, -roll),
+                                                         np.roll(BP, -roll, axis=0), p, q, nid)
+            if kind == "grid" and p > 1 and q > 1:
+                swept.setdefault((p, q), []).append((len(positions), grid_sides))
         else:
             corners = [starts[s[0]] for s in sides] if kind == "split-coons4" else None
             newpos, quads, nid = _split_patch(B, BP, N, nid, corners)
@@ -444,7 +328,19 @@ def build_control_mesh(curves, loops, resolution: int = 4, *,
     target = V.copy()
     return ControlMesh(V, np.concatenate(quads_all).astype(np.int64),
                        np.concatenate(fpatch).astype(np.int64), curve_vids, on_curve, target,
-                       jend, len(jpos), loops, kinds, diag)
+                       jend, len(jpos), loops, kinds, diag, rest=_swept_rest(positions, swept),
+                       swept=np.array([k == "grid" for k in kinds], bool))
+
+
+def _swept_rest(positions, swept) -> np.ndarray:
+    """The control vertices with the insides of the grid loops swept
+    (:func:`.sweep.sweep_grid`), loops of one size at once: ``(n, 3) float64``."""
+    rest = list(positions)
+    for (p, q), items in swept.items():
+        grids = sweep_grid(*(np.stack(side) for side in zip(*(sides for _, sides in items))))
+        for (block, _), grid in zip(items, grids):
+            rest[block] = grid[1:p, 1:q].reshape(-1, 3)
+    return np.concatenate(rest)
 
 
 def _sample_curves(curves, jend, jpos, k_c):
@@ -525,19 +421,18 @@ def _patch_layout(lp, dense, starts, k_c, N, Lb, straight_angle):
 def _grid_patch(Br, BPr, p, q, nid):
     """Coons grid of ``p x q`` quads inside the border ``Br`` (ids) / ``BPr`` (positions).
 
-    Returns the new interior positions ``((p-1)(q-1), 3)``, the quads ``(p q, 4)``
+    Returns the new interior positions ``((p-1)(q-1), 3)``, the four sides (bottom,
+    right, top, left, as :func:`.coons.coons_grid` takes them), the quads ``(p q, 4)``
     and the next free vertex id.
     """
     Lb = len(Br)
     G, nid = _grid_ids(Br, p, q, nid)
     idx = np.arange(Lb)
-    bottom = BPr[idx[:p + 1]]
-    right = BPr[idx[p:p + q + 1]]
-    top = BPr[(p + q + (p - np.arange(p + 1))) % Lb]
-    left = BPr[(2 * p + q + (q - np.arange(q + 1))) % Lb]
-    grid = coons_grid(bottom, right, top, left)
-    newpos = grid[1:p, 1:q].reshape(-1, 3) if p > 1 and q > 1 else np.zeros((0, 3))
-    return newpos, _grid_quads(G), nid
+    sides = (BPr[idx[:p + 1]], BPr[idx[p:p + q + 1]],
+             BPr[(p + q + (p - np.arange(p + 1))) % Lb],
+             BPr[(2 * p + q + (q - np.arange(q + 1))) % Lb])
+    newpos = coons_grid(*sides)[1:p, 1:q].reshape(-1, 3) if p > 1 and q > 1 else np.zeros((0, 3))
+    return newpos, sides, _grid_quads(G), nid
 
 
 def _split_patch(B, BP, N, nid, corners):

@@ -12,7 +12,10 @@ curves) with their targets, and the control mesh's edges.
   bi-Laplacian, a thin-plate energy) subject to ``L[c] @ P = q_crv`` exactly
   (the "least squares formulation proposed by [HKD93]" the paper mentions), or
   with a finite ``curve_weight`` as a penalty. The KKT system is factorised once
-  with SuperLU (:func:`solve_kkt`) and solved for x, y, z together.
+  with SuperLU (:func:`solve_kkt`) and solved for x, y, z together. With fairness
+  *goals* ``g`` it minimises ``|| F P - g ||^2`` instead, one fit per goal from the
+  same factorisation: ``g = F @ rest`` on the rows :func:`swept_rows` selects keeps
+  the shape of a rest mesh (the swept patches of :mod:`.sweep`) between the curves.
 
 Notes
 -----
@@ -27,14 +30,15 @@ import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 
+from curvenet.core.geometry import face_normals_areas
 from curvenet.core.tolerances import DIVISION_GUARD
 
 from .catmull_clark import CORNER, CREASE, edge_topology, sharp_mask, vertex_classes
 from .limit import limit_normals
 
 __all__ = ["LAMBDA", "VSPRING_STEP", "FAIRNESS", "PIVOTED_MAX", "QUASI_EPS", "fairness_matrix",
-           "variation_matrix", "fit_lsq", "solve_kkt", "fit_iterative", "vspring_displacement",
-           "bending_energy"]
+           "variation_matrix", "swept_rows", "fit_lsq", "solve_kkt", "fit_iterative",
+           "vspring_displacement", "bending_energy"]
 
 #: Fairness energies of :func:`fit_lsq`: ``"variation"`` penalises the differences of the
 #: umbrella Laplacian across edges (``|| D F P ||^2``, a linear stand-in for V-spring's
@@ -62,6 +66,9 @@ _REFINE_RTOL = 1e-13
 VSPRING_STEP = 0.5
 #: Guard for V-spring's ``1 + n_i . n_j`` when the two normals are opposite.
 _VSPRING_DEN_MIN = 1e-2
+#: Triangles below this fraction of the median triangle area have no curvature estimate
+#: in :func:`bending_energy`.
+_DEGENERATE_AREA = 1e-10
 
 
 def fairness_matrix(quads, n_vertices: int, sharp_edges=None, corners=None) -> sp.csr_matrix:
@@ -110,8 +117,38 @@ def variation_matrix(F) -> sp.csr_matrix:
     return (D @ F).tocsr()
 
 
+def swept_rows(F, quads, face_patch, swept) -> np.ndarray:
+    """Rows of a fairness operator whose every vertex lies on swept patches only.
+
+    Parameters
+    ----------
+    F : (m, n) sparse
+        Fairness operator (:func:`fairness_matrix` or :func:`variation_matrix`).
+    quads : (f, 4) int64
+    face_patch : (f,) int64
+        Patch of each quad.
+    swept : (P,) bool
+        Patches with a swept rest shape.
+
+    Returns
+    -------
+    (m,) bool
+        True where the row's stencil touches no quad of an unswept patch: there the
+        goal ``F @ rest`` of the ``sweep`` fit applies (a curve between two swept
+        patches included, so that the rest shape carries across it); elsewhere the
+        goal is zero, the plain fairness.
+    """
+    q = np.asarray(quads, dtype=np.int64)
+    n = F.shape[1]
+    bad = np.zeros(n, bool)
+    bad[q[~np.asarray(swept, bool)[np.asarray(face_patch)]].ravel()] = True
+    pattern = F.tocsr().copy()
+    pattern.data = np.ones_like(pattern.data)
+    return (pattern @ bad.astype(np.float64)) == 0
+
+
 def fit_lsq(L, F, P0, constrained, targets, *, curve_weight: float | None = None,
-            extra=None):
+            extra=None, goals=None):
     """Direct sparse fit of the limit surface to the curve samples.
 
     Parameters
@@ -134,10 +171,13 @@ def fit_lsq(L, F, P0, constrained, targets, *, curve_weight: float | None = None
     extra : (A2 (k2, n) sparse, q2 (k2, 3), w2 float), optional
         Soft rows added to the energy as ``w2 || A2 P - q2 ||^2`` (e.g. limit points
         of a finer level along the curves, between the interpolated samples).
+    goals : list of (m, 3) float64, optional
+        Fairness goals ``g``: minimise ``|| F P - g ||^2`` (None in the list: zero,
+        the plain fairness), each a fit of its own from one factorisation.
 
     Returns
     -------
-    P : (n, 3) float64
+    P : (n, 3) float64, or (len(goals), n, 3) float64 when ``goals`` is given
     """
     P0 = np.asarray(P0, dtype=np.float64)
     n = len(P0)
@@ -150,23 +190,32 @@ def fit_lsq(L, F, P0, constrained, targets, *, curve_weight: float | None = None
         A2, q2, w2 = extra
         H = (H + w2 * (A2.T @ A2)).tocsr()
         rhs0 = rhs0 + w2 * (A2.T @ np.asarray(q2, dtype=np.float64))
+    targets = np.asarray(targets, dtype=np.float64)
+    many = goals is not None
+    if many:       # one right-hand side of three columns per goal
+        rhs0 = np.hstack([rhs0 if g is None else rhs0 + F.T @ np.asarray(g, np.float64)
+                          for g in goals])
+        targets = np.tile(targets, (1, len(goals)))
     if curve_weight is None:
-        return solve_kkt(H, A, rhs0, np.asarray(targets, dtype=np.float64))[:n]
-    if curve_weight <= 0:
+        P = solve_kkt(H, A, rhs0, targets)[:n]
+    elif curve_weight <= 0:
         raise ValueError(f"curve_weight: expected > 0 or None, got {curve_weight}")
-    M = (H + curve_weight * (A.T @ A)).tocsc()
-    return spla.splu(M).solve(rhs0 + curve_weight * (A.T @ targets))
+    else:
+        M = (H + curve_weight * (A.T @ A)).tocsc()
+        P = spla.splu(M).solve(rhs0 + curve_weight * (A.T @ targets))
+    return P.reshape(n, -1, 3).transpose(1, 0, 2) if many else P
 
 
 def solve_kkt(H, A, rhs0, targets) -> np.ndarray:
-    """Solve ``[[H, A^T], [A, 0]] [P; lam] = [rhs0; targets]``, ``((n + k), 3) float64``.
+    """Solve ``[[H, A^T], [A, 0]] [P; lam] = [rhs0; targets]``, ``((n + k), c) float64``.
 
     Parameters
     ----------
     H : (n, n) sparse, symmetric positive definite
     A : (k, n) sparse
-    rhs0 : (n, 3) float64
-    targets : (k, 3) float64
+    rhs0 : (n, c) float64
+    targets : (k, c) float64
+        ``c`` right-hand sides (3 per fit: x, y, z).
 
     Notes
     -----
@@ -330,6 +379,9 @@ def bending_energy(vertices, faces) -> float:
     ``H_v`` is the mean curvature from the cotangent Laplacian (``|L x| / 2 A_v``),
     ``A_v`` the vertex's Voronoi area (libigl). Scale invariant: a round sphere of any
     size gives ``4 pi``, and folds, flattened caps and bulges between curves raise it.
+    Triangles of (nearly) zero area, which limit meshes of control nets with coincident
+    points have, have no cotangents: they are left out, and their vertices with them
+    (their one-rings are open).
 
     Parameters
     ----------
@@ -344,11 +396,19 @@ def bending_energy(vertices, faces) -> float:
 
     V = np.ascontiguousarray(vertices, dtype=np.float64)
     F = np.ascontiguousarray(faces, dtype=np.int64)
+    _, face_area = face_normals_areas(V, F)
+    F = np.ascontiguousarray(F[face_area > _DEGENERATE_AREA * max(float(np.median(face_area)),
+                                                                  DIVISION_GUARD)])
+    if not len(F):
+        return 0.0
     L = igl.cotmatrix(V, F)
-    area = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal()
+    area = np.zeros(len(V))                # libigl sizes it by the largest index used
+    mass = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal()
+    area[:len(mass)] = mass
     hn = (L @ V) / (2.0 * np.maximum(area, DIVISION_GUARD)[:, None])
     e = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
     _, idx, count = np.unique(e, axis=0, return_index=True, return_counts=True)
-    inner = np.ones(len(V), bool)
+    inner = np.zeros(len(V), bool)
+    inner[F.ravel()] = True
     inner[e[idx[count == 1]].ravel()] = False          # open-boundary vertices
     return float(((hn ** 2).sum(1) * area)[inner].sum())

@@ -10,8 +10,10 @@ surface. The truth is the surface itself (:func:`implicit_mesh`, marching cubes)
 
 The shapes of the genus benchmark (``benchmarks/bench_genus.py``): spheres from great
 circles (:func:`great_circles`), capsules with rings (:func:`capsule`), a double torus
-of two blended tori (:func:`double_torus`); tori with any number of rings and
-meridians are :func:`curvenet.datasets.shapes.torus`.
+of two blended tori (:func:`double_torus`), tori cut by horizontal planes at any
+heights and by half-planes at any angles (:func:`torus_sections`: rings and meridians
+spaced unevenly); evenly spaced rings and meridians are
+:func:`curvenet.datasets.shapes.torus`.
 
 Examples
 --------
@@ -30,7 +32,7 @@ from ..model.network import CurveNetwork
 from .shapes import AnalyticShape
 
 __all__ = ["section_network", "implicit_mesh", "great_circles", "capsule", "double_torus",
-           "torus_sdf", "smooth_union"]
+           "torus_sections", "torus_sdf", "smooth_union"]
 
 #: Grid cells per side of the sections traced on each plane.
 SECTION_CELLS = 400
@@ -272,6 +274,39 @@ def capsule(*, radius: float = 0.5, length: float = 1.0, rings: int = 3, meridia
     b = radius * 1.2
     return _shape(f"capsule_{rings}x{meridians}", F, planes,
                   ((-b, -b, -length / 2 - b), (b, b, length / 2 + b)), 0, samples)
+
+
+def torus_sections(major: float = 1.0, minor: float = 0.4, *, heights=(0.0,),
+                   angles=(0.0, 120.0, 240.0), samples: int = 33) -> AnalyticShape:
+    """A torus around z drawn as horizontal sections and meridians, spaced as given.
+
+    Parameters
+    ----------
+    major, minor : float
+        Radii.
+    heights : sequence of float
+        Heights of the horizontal cutting planes, fractions of ``minor`` in (-1, 1);
+        each plane gives two rings (0: the outer and inner equators).
+    angles : sequence of float
+        Degrees about z of the meridians (each the section of a half-plane).
+    samples : int
+        Points per curve.
+
+    Examples
+    --------
+    >>> s = torus_sections(heights=(0.0, 0.7), angles=(0, 90, 180, 270))
+    >>> s.network.number_of_edges - s.network.number_of_vertices + 2 - 2 * s.genus
+    16
+    """
+    planes = [((0, 0, h * minor), (0, 0, 1)) for h in heights]
+    for a in np.radians(np.asarray(angles, np.float64)):
+        d = np.array([np.cos(a), np.sin(a), 0.0])
+        planes.append(((0, 0, 0), (-d[1], d[0], 0.0), lambda c, d=d: float(c @ d) > 0))
+    b = major + minor + 0.2 * major
+    name = (f"torus r{minor / major:g} h{','.join(f'{h:g}' for h in heights)} "
+            f"a{','.join(f'{a:g}' for a in angles)}")
+    return _shape(name, torus_sdf((0.0, 0.0, 0.0), major, minor), planes,
+                  ((-b, -b, -minor - 0.2 * major), (b, b, minor + 0.2 * major)), 1, samples)
 
 
 def double_torus(*, major: float = 1.0, minor: float = 0.35, meridians: int = 3,

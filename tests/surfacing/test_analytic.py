@@ -169,11 +169,16 @@ def test_fit_circle_tells_arcs_from_lines():
 
 
 def test_a_bore_wall_mesh_lies_on_its_cylinder():
-    """A tube with one seam (the loop walks the seam twice): the Catmull-Clark fit sinks
-    between the circles; the analytic face puts the mesh back on the cylinder."""
+    """A tube with one seam (the loop walks the seam twice): the least-squares
+    Catmull-Clark fit sinks between the circles (the swept fit much less); the analytic
+    face puts the mesh back on the cylinder."""
     top, bottom, seam = _circle(1.0, 1.0), _circle(1.0, 0.0), _line((1, 0, 1), (1, 0, 0))
     boundary = [[[(0, True), (2, True), (1, False), (2, False)]]]
-    free = surface_boundaries([top, bottom, seam], boundary, analytic_tol=None, subdiv=2)
+    free = surface_boundaries([top, bottom, seam], boundary, analytic_tol=None, subdiv=2,
+                              fit="lsq")
+    swept = surface_boundaries([top, bottom, seam], boundary, analytic_tol=None, subdiv=2)
+    assert swept.report["fit"] == "sweep"
+    assert np.abs(np.hypot(*swept.vertices[:, :2].T) - 1).max() < 0.05
     on = surface_boundaries([top, bottom, seam], boundary, subdiv=2)
     assert np.abs(np.hypot(*free.vertices[:, :2].T) - 1).max() > 0.05
     assert np.abs(np.hypot(*on.vertices[:, :2].T) - 1).max() < 1e-12

@@ -120,7 +120,7 @@ def test_non_manifold_curve_is_shared_by_the_pieces():
 
 
 def test_adaptive_pieces_follow_quad_strips():
-    from curvenet.surfacing.controlmesh import curve_pieces
+    from curvenet.surfacing.pieces import curve_pieces
     t = np.linspace(0, 1, 33)[:, None]
     curves = [t * [3, 0, 0], [3, 0, 0] + t * [0, 1, 0], [3, 1, 0] - t * [3, 0, 0],
               [0, 1, 0] - t * [0, 1, 0]]
@@ -141,7 +141,7 @@ def test_stroke_wobble_does_not_count_as_winding():
     # of 1% of its length, three periods: the scale of the re-drawn torus's strokes),
     # which adds up when summed over fine segments (136 degrees at 32). It stays one
     # piece, like the clean arc; a half circle (180 degrees) gets two either way.
-    from curvenet.surfacing.controlmesh import curve_pieces
+    from curvenet.surfacing.pieces import curve_pieces
     t = np.linspace(0, 1, 200)
 
     def arc(turn, wobble):
@@ -189,7 +189,7 @@ def test_bad_loops_rejected():
 
 def test_vectorised_turning_is_the_per_curve_loop_bit_for_bit():
     """Oracle: the one-curve :func:`_turning` and a loop over scales (issue 32)."""
-    from curvenet.surfacing.controlmesh import (PIECE_ROUNDING, PIECE_TURN, TURN_SCALES,
+    from curvenet.surfacing.pieces import (PIECE_ROUNDING, PIECE_TURN, TURN_SCALES,
                                                 TURN_SEGMENTS, _turning, _turnings,
                                                 _turns_pieces)
     rng = np.random.default_rng(3)
