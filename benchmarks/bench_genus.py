@@ -11,7 +11,12 @@ Shapes (all built here or in :mod:`curvenet.datasets`, none tuned one by one):
 * tori ``R = 1``, ``r`` in {0.25, 0.4, 0.6}, 3-6 meridians and 2-4 rings
   (:func:`curvenet.datasets.shapes.torus`);
 * spheres from 3 and 4 great circles, capsules with rings, a capped cylinder, a
-  double torus (:mod:`curvenet.datasets.sections`).
+  double torus (:mod:`curvenet.datasets.sections`);
+* ``uneven``: tori cut by horizontal planes at random heights and by meridians at
+  random angles (:func:`curvenet.datasets.sections.torus_sections`, 1-2 planes, so 2-4
+  rings, and 3-5 meridians; drawn from a seeded generator, never picked one by one:
+  rings at least a third of the minor radius apart in height, meridians at least 40
+  degrees apart), each turned, scaled and moved at random in space.
 
 Inputs per shape: ``clean`` (the network's curves as strokes), ``through`` (each
 section drawn as one stroke through its crossings, with a smooth wobble of 0.3% of the
@@ -30,6 +35,7 @@ import argparse
 import json
 import sys
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -39,6 +45,7 @@ from curvenet.core.geometry import cumulative_length, interpolate_polyline
 from curvenet.datasets import sections, shapes
 from curvenet.datasets.redraw import rough_sketch
 from curvenet.evaluate import evaluate_mesh
+from curvenet.model.network import CurveNetwork
 from curvenet.model.sketch import Sketch
 
 ROOT = Path(__file__).resolve().parent
@@ -60,7 +67,53 @@ def cases():
     out.append(("cylinder", shapes.capped_cylinder(n_around=4, n_height=3)))
     out.append(("double torus", sections.double_torus()))
     out.append(("double torus", sections.double_torus(meridians=2, rings=(-0.5, 0.5))))
+    return out + [("uneven", s) for s in uneven_tori(UNEVEN)]
+
+
+#: Uneven tori in the benchmark.
+UNEVEN = 12
+
+
+def uneven_tori(n: int, seed: int = 30):
+    """``n`` tori with unevenly spaced rings and meridians, moved in space (the ``uneven``
+    family; see the module's docstring)."""
+    rng = np.random.default_rng(seed)
+    out = []
+    while len(out) < n:
+        minor = round(float(rng.uniform(0.2, 0.6)), 2)
+        heights = np.sort(rng.uniform(-0.8, 0.8, int(rng.integers(1, 3))))
+        angles = np.sort(rng.uniform(0.0, 360.0, int(rng.integers(3, 6))))
+        gaps = np.diff(np.r_[angles, angles[0] + 360.0])
+        if np.diff(heights).min(initial=1.0) < 1 / 3 or gaps.min() < 40.0:
+            continue
+        shape = sections.torus_sections(1.0, minor, heights=tuple(np.round(heights, 2)),
+                                        angles=tuple(np.round(angles)))
+        out.append(_moved(shape, rng))
     return out
+
+
+def _moved(shape, rng):
+    """The shape turned, scaled and moved at random: network and true surface alike."""
+    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    q *= np.sign(np.linalg.det(q))
+    scale = float(10.0 ** rng.uniform(-1, 2))
+    shift = rng.normal(size=3) * scale
+
+    def move(p):
+        return scale * np.asarray(p, np.float64) @ q.T + shift
+
+    net = shape.network
+    moved = CurveNetwork(move(net.positions))
+    for e in net.edges:
+        moved.add_edge(e.u, e.v, move(e.curve), label=e.label)
+    reference = shape.reference
+
+    def moved_reference(level):
+        mesh = reference(level).copy()
+        mesh.vertices = move(mesh.vertices)
+        return mesh
+
+    return replace(shape, network=moved, reference=moved_reference)
 
 
 def _through_paths(net):
@@ -168,7 +221,7 @@ def main(argv=None):
     args = ap.parse_args(argv)
     if args.pictures:
         args.pictures.mkdir(parents=True, exist_ok=True)
-    print(f"{'case':<22}{'input':<9}{'route':<12}{'mode':<7}{'patches':>8}{'F':>8}"
+    print(f"{'case':<34}{'input':<9}{'route':<12}{'mode':<7}{'patches':>8}{'F':>8}"
           f"{'Chamfer':>10}{'fid':>7}{'s':>7}")
     worst: dict = {}
     for family, shape in cases():
@@ -178,10 +231,10 @@ def main(argv=None):
             try:
                 r = run(shape, kind, args.pictures, args.classical)
             except curvenet.CurvenetError as err:
-                print(f"{shape.name:<22}{kind:<9}failed: {err}")
+                print(f"{shape.name:<34}{kind:<9}failed: {err}")
                 worst[(family, kind)] = 0.0
                 continue
-            print(f"{r['case']:<22}{kind:<9}{r['route']:<12}{r['mode']:<7}{r['patches']:>8}"
+            print(f"{r['case']:<34}{kind:<9}{r['route']:<12}{r['mode']:<7}{r['patches']:>8}"
                   f"{r['F']:>8.3f}{r['chamfer']:>10.2e}{r['fidelity']:>7.3f}{r['s']:>7.1f}",
                   flush=True)
             worst[(family, kind)] = min(worst.get((family, kind), 1.0), r["F"])
