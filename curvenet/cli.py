@@ -305,6 +305,7 @@ def _surface_one(inp: str, out: str, args) -> dict:
     """Surface one input; returns a status row (never raises CurvenetError)."""
     from .io.network import read_patches
     from .pipeline import surface
+    from .surfacing.api import explain_fit
     t0 = time.perf_counter()
     try:
         ps = read_patches(args.patches) if args.patches else None
@@ -329,6 +330,7 @@ def _surface_one(inp: str, out: str, args) -> dict:
                 "snap": res.diagnostics.get("snap", {}).get("summary", ""),
                 "regions": res.decision.explain_regions(),
                 "check": res.decision.explain_check(),
+                "fit": explain_fit(res.diagnostics.get("classical")),
                 "fidelity": res.diagnostics.get("fidelity"),
                 "cad": res.diagnostics.get("cad")}
     except CurvenetError as err:
@@ -397,6 +399,8 @@ def _cmd_surface(args) -> int:
             print(f"  region {line}")
         if row.get("check"):
             print(row["check"])
+        if row.get("fit"):
+            print(row["fit"])
         if row.get("fidelity"):
             from .core.fidelity import format_fidelity
             print(format_fidelity(row["fidelity"]))

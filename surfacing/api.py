@@ -30,7 +30,8 @@ from .soap import soapfilm_mesh
 __all__ = ["PatchMeshResult", "surface_loops", "soapfilm_loops", "check_loops_options",
            "FITS", "AUTO_FIT_MAX_VERTICES", "AUTO_FIT_MAX_ITER", "AUTO_FIT_MAX_LEVEL_VERTICES",
            "AUTO_FIT_TIE", "AUTO_FIT_PREFERENCE", "DEFAULT_RESOLUTION", "DEFAULT_SUBDIV",
-           "DEFAULT_TOL", "DEFAULT_EDGE_LENGTH", "DEFAULT_MAX_FACES", "density_subdiv"]
+           "DEFAULT_TOL", "DEFAULT_EDGE_LENGTH", "DEFAULT_MAX_FACES", "density_subdiv",
+           "explain_fit"]
 
 #: Fits of :func:`surface_loops`: ``auto`` (those below, the fairest kept), ``lsq``,
 #: ``sweep``, ``iterative``.
@@ -497,6 +498,38 @@ def _report(cm, *, fit, dev, sample_dev, iters, timings, crease, detected, n_fac
         "resolution": int(resolution) + int(resolution) % 2,
         "subdiv": subdiv,
     }
+
+
+def explain_fit(report) -> str | None:
+    """The line ``--explain`` prints about the fit of a :func:`surface_loops` report.
+
+    Parameters
+    ----------
+    report : dict or None
+        ``PatchMeshResult.report`` (its ``fit`` and, for ``auto``, ``energy``).
+
+    Returns
+    -------
+    str or None
+        None when the report has no fit (another surfacer's).
+
+    Examples
+    --------
+    >>> print(explain_fit({"fit": "sweep", "energy": {"lsq": 85.9, "sweep": 66.64,
+    ...                                               "iterative": None}}))
+    fit: sweep (bending energy lsq 85.9, sweep 66.6, iterative not tried; the least kept, ties within 1% going to sweep, then lsq)
+    >>> print(explain_fit({"fit": "lsq"}))
+    fit: lsq
+    """
+    if not report or report.get("fit") not in FITS:
+        return None
+    energy = report.get("energy")
+    if not energy or all(e is None for e in energy.values()):
+        return f"fit: {report['fit']}"
+    figures = ", ".join(f"{k} {e:.1f}" if e is not None else f"{k} not tried"
+                        for k, e in energy.items())
+    return (f"fit: {report['fit']} (bending energy {figures}; the least kept, ties within "
+            f"{AUTO_FIT_TIE:.0%} going to {', then '.join(AUTO_FIT_PREFERENCE[:2])})")
 
 
 def soapfilm_loops(curves, loops, *, resolution: int = 16, **_ignored) -> PatchMeshResult:

@@ -171,6 +171,9 @@ def test_snap_and_explain_print_the_snapping_line(tmp_path):
     r = run("surface", rough, "-o", tmp_path / "s.obj", "--method", "classical", "--explain")
     assert r.returncode == 0, r.stderr
     assert any(x.startswith("snap: tolerance") for x in r.stdout.splitlines())
+    # the fit auto kept, with the bending energy of each fit it tried
+    fit = [x for x in r.stdout.splitlines() if x.startswith("fit: ")]
+    assert len(fit) == 1 and "bending energy lsq " in fit[0] and "sweep " in fit[0]
 
 
 def test_edge_length_sets_the_output_density(tmp_path, box_obj):
