@@ -390,17 +390,12 @@ def _cmd_surface(args) -> int:
     print(f"{row['output']}: {row['faces']} faces, {row['method']}, "
           f"{row['seconds']:.1f} s{partial}")
     if args.explain:
-        if row.get("reading"):
-            print(f"reading: {row['reading']}")
-        if row["snap"]:
-            print(row["snap"])
-        print(f"route: {row['why']}")
-        for line in row.get("regions", []):
-            print(f"  region {line}")
-        if row.get("check"):
-            print(row["check"])
-        if row.get("fit"):
-            print(row["fit"])
+        reading = row.get("reading") and f"reading: {row['reading']}"
+        for line in [reading, row["snap"], f"route: {row['why']}",
+                     *(f"  region {r}" for r in row.get("regions", [])),
+                     row.get("check"), row.get("fit")]:
+            if line:
+                print(line)
         if row.get("fidelity"):
             from .core.fidelity import format_fidelity
             print(format_fidelity(row["fidelity"]))
