@@ -183,6 +183,14 @@ def _control_uv(curve) -> np.ndarray:
                      (curve.Points[i] for i in range(len(curve.Points)))])
 
 
+def _sampled_uv(curve, n: int = 33) -> np.ndarray:
+    """(n, 2) float64: points of a 2D NURBS curve at ``n`` even parameters (a rational
+    curve's control points may lie far off it)."""
+    d = curve.Domain
+    return np.array([[p.X, p.Y] for p in (curve.PointAt(t)
+                                          for t in np.linspace(d.T0, d.T1, n))])
+
+
 def _iso(curve, surface) -> int:
     """The ``m_iso`` flag openNURBS expects of a trim (``ON_Surface::IsIsoparametric``
     of the trim curve: its control points' box against the surface's domain, then
@@ -212,6 +220,62 @@ def _iso(curve, surface) -> int:
         if not curve.IsLinear(float(ext[k])):
             iso = 0
     return iso
+
+
+def _into_window(bs, uv: np.ndarray) -> np.ndarray:
+    """Put a face's trims and its closed surface's domain in the same period; returns
+    the shift ((2,) float64) its trims take, and may move ``bs``'s origin.
+
+    OpenCascade's curves on a closed surface may lie in another period than the surface's
+    domain (a sphere's loop at ``u`` in ``[1.7, 8.0]`` on a domain ``[-2.1, 4.2]``: NURBS
+    conversion keeps the pcurves, and evaluation off the domain extrapolates). In each
+    parameter in which the surface is closed, the trims move by whole periods so their
+    lowest ``u`` lies in the domain; where they then still run past its end, the surface
+    is made periodic, given a knot at their lowest ``u`` as its origin and opened there
+    (``Geom_BSplineSurface::SetUOrigin``), so its domain is the trims' period. A face
+    whose trims span more than one period is left as it is.
+
+    Parameters
+    ----------
+    bs : OCP.Geom.Geom_BSplineSurface
+        The face's surface, changed in place.
+    uv : (n, 2) float64
+        Points along all the face's trims.
+    """
+    shift = np.zeros(2)
+    ends = bs.Bounds()
+    for k in (0, 1):
+        lo, hi = ends[2 * k], ends[2 * k + 1]
+        period, tol = hi - lo, 1e-9 * max(1.0, hi - lo)
+        closed = (bs.IsUClosed() or bs.IsUPeriodic()) if k == 0 else \
+            (bs.IsVClosed() or bs.IsVPeriodic())
+        a, b = uv[:, k].min(), uv[:, k].max()
+        if not closed or (lo - tol <= a and b <= hi + tol) or b - a > period + tol:
+            continue
+        shift[k] = -np.floor((a - lo + tol) / period) * period
+        a += shift[k]
+        if b + shift[k] <= hi + tol:
+            continue
+        periodic, insert, origin, index = ((bs.SetUPeriodic, bs.InsertUKnot, bs.SetUOrigin,
+                                            bs.UKnot) if k == 0 else
+                                           (bs.SetVPeriodic, bs.InsertVKnot, bs.SetVOrigin,
+                                            bs.VKnot))
+        periodic()
+        insert(a, 1, tol, True)
+        n = bs.NbUKnots() if k == 0 else bs.NbVKnots()
+        origin(min(range(1, n + 1), key=lambda i: abs(index(i) - a)))
+    return shift
+
+
+def _shifted(curve, shift):
+    """A 2D NURBS curve moved by ``shift`` ((2,) float64) in place; returns it."""
+    import rhino3dm
+    if shift.any():
+        for i in range(len(curve.Points)):
+            p = curve.Points[i]
+            curve.Points[i] = rhino3dm.Point4d(p.X + shift[0] * p.W, p.Y + shift[1] * p.W,
+                                               p.Z, p.W)
+    return curve
 
 
 def _domain_of(surface, k: int) -> tuple:
@@ -379,20 +443,24 @@ def brep_bytes(shape, tolerance: float) -> bytes:
     for fi in range(1, F.Size() + 1):
         face0 = TopoDS.Face(F.FindKey(fi))
         face = TopoDS.Face(face0.Oriented(TopAbs_FORWARD))
-        surfaces.append(_on_surface(GeomConvert.SurfaceToBSplineSurface_s(
-            BRep_Tool.Surface_s(face))))
         outer = BRepTools.OuterWire_s(face)
         wires, exp = [], TopExp_Explorer(face, TopAbs_WIRE)
         while exp.More():
             w = TopoDS.Wire(exp.Current())
             (wires.insert(0, w) if w.IsSame(outer) else wires.append(w))
             exp.Next()
+        wire_items = [[(e, edge_of.get(E.FindIndex(e) - 1, -1),
+                        _on_curve(_bspline2d(e, face), 2)) for e in _wire_edges(w, face)]
+                      for w in wires]
+        bss = GeomConvert.SurfaceToBSplineSurface_s(BRep_Tool.Surface_s(face))
+        shift = _into_window(bss, np.vstack([_sampled_uv(c) for items in wire_items
+                                             for _, _, c in items]))
+        surfaces.append(_on_surface(bss))
         lis = []
-        for w in wires:
+        for items in wire_items:
             li, tis = len(loops), []
-            items = [(e, edge_of.get(E.FindIndex(e) - 1, -1), _on_curve(_bspline2d(e, face), 2))
-                     for e in _wire_edges(w, face)]
-            for e, ei, curve in _poles_only(items, surfaces[-1]):
+            for e, ei, curve in _poles_only([(e, ei, _shifted(c, shift)) for e, ei, c in items],
+                                            surfaces[-1]):
                 rev = e.Orientation() == TopAbs_REVERSED
                 seam = BRep_Tool.IsClosed_s(e, face)
                 ti = len(trims)

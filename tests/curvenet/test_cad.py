@@ -213,18 +213,21 @@ def test_3dm_is_one_joined_closed_brep(tmp_path, make):
     # B-spline pieces have knots refined toward their sides, and openNURBS scales its
     # parameter tolerance with the end span: a trim a hair off a side is no side iso
     # there, and a Brep whose m_iso flags disagree is invalid (the cup's three were)
-    ("cup", 3),
+    ("mingzou/cup", 3),
     # healing closes a gap in one of the submarine's loops with a degenerate edge that
     # is no pole; BRepTools_WireExplorer stopped there and the loop lost five of its
     # eight edges ("trim vertex mismatch"): the wire's own order is walked instead, the
     # degenerate edge left out and the pole trims left put on their sides
-    ("SGA_Submarine", 3),
+    ("mingzou/SGA_Submarine", 3),
+    # a sphere face whose loop crosses the seam of the NURBS conversion's domain: its
+    # trims were evaluated off the surface (see _into_window)
+    ("flowrep/spherecylinder", 1),
 ])
 def test_3dm_of_public_networks_is_valid(tmp_path, data_dir, stem, breps):
     pytest.importorskip("rhino3dm")
     pytest.importorskip("OCP")
     from curvenet import cad
-    res = surface(data_dir / "networks" / "mingzou" / f"{stem}.obj", method="classical",
+    res = surface(data_dir / "networks" / f"{stem}.obj", method="classical",
                   classical_options={"subdiv": 1})
     res.save(tmp_path / "c.3dm")
     got = cad.read_3dm_breps(tmp_path / "c.3dm")
@@ -296,3 +299,32 @@ def test_cli_step_explain(tmp_path, capsys):
              for n in ("box", "sheet")]
     assert faces == [6, 9]
     assert '"cad_faces": 6' in rep.read_text().replace("\n", " ")
+
+
+@pytest.mark.parametrize("u0, u1", [(-1.0, 2.0),      # a whole period off the domain
+                                     (7.0, 12.5),     # runs past the domain's end
+                                     (-2.0, 4.2)])    # already in it
+def test_trims_and_a_closed_surface_are_put_in_one_period(u0, u1):
+    """OpenCascade's curves on a closed surface may lie in another period than the
+    surface's NURBS domain (flowrep/spherecylinder: a loop at u in [1.7, 8.0] on a domain
+    [-2.1, 4.2] made its 3DM invalid); after ``_into_window`` the shifted trims lie in the
+    domain and map to the same points of the surface."""
+    pytest.importorskip("rhino3dm")
+    pytest.importorskip("OCP")
+    from OCP.Geom import Geom_CylindricalSurface, Geom_RectangularTrimmedSurface
+    from OCP.GeomConvert import GeomConvert
+    from OCP.gp import gp_Ax3
+    from curvenet.cad.rhino import _into_window
+    def converted():        # a closed, non-periodic NURBS cylinder on u in [4.28, 10.57]
+        return GeomConvert.SurfaceToBSplineSurface_s(Geom_RectangularTrimmedSurface(
+            Geom_CylindricalSurface(gp_Ax3(), 1.0), -2.0, -2.0 + 2 * np.pi, 0.0, 1.0))
+    bs, periodic = converted(), converted()
+    periodic.SetUPeriodic()         # evaluates any u as the same point of its period
+    uv = np.column_stack([np.linspace(u0, u1, 50), np.linspace(0.2, 0.8, 50)])
+    shift = _into_window(bs, uv)
+    lo, hi, _, _ = bs.Bounds()
+    moved = uv + shift
+    assert lo - 1e-9 <= moved[:, 0].min() and moved[:, 0].max() <= hi + 1e-9
+    for (u, v), (s, t) in zip(uv, moved):
+        p, q = periodic.Value(u, v), bs.Value(s, t)
+        assert p.Distance(q) < 1e-9
