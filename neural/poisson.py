@@ -261,10 +261,11 @@ class PoissonSolver:
             + (torch.fft.rfftfreq(n, d=1.0 / n, dtype=torch.float64) ** 2).view(1, 1, -1)
         inv = torch.where(uu > 0, 1.0 / (-2.0 * math.pi * uu.clamp(min=TINY_F32)),
                           torch.zeros_like(uu))
-        # u / (-2 pi |u|^2) per axis, real: (3, n, n, n//2+1); the factor i is applied once
+        # i u / (-2 pi |u|^2) per axis: (3, n, n, n//2+1), complex, stored so (a real
+        # operator would be converted to complex on every multiply)
         op = torch.stack([(ux * inv).expand(n, n, -1), (uy * inv).expand(n, n, -1),
-                          (uz * inv).expand(n, n, -1)])
-        self._op = op.to(device=device, dtype=dtype).contiguous()
+                          (uz * inv).expand(n, n, -1)]).to(device=device, dtype=dtype)
+        self._op = torch.complex(torch.zeros_like(op), op).contiguous()
 
     def _init_sine(self) -> None:
         """Bases of the Dirichlet solve: f = sum_k a_k prod_axes sin(pi k x), k = 1..n.
@@ -328,7 +329,41 @@ class PoissonSolver:
         return f
 
     def _spectral(self, g_grid: torch.Tensor) -> torch.Tensor:
-        n = self.res
-        gh = torch.fft.rfftn(g_grid, dim=(-3, -2, -1))           # (3, n, n, n//2+1)
-        fh = 1j * (self._op * gh).sum(0)
-        return torch.fft.irfftn(fh, s=(n, n, n), dim=(-3, -2, -1))
+        return _Spectral.apply(g_grid, self._op)
+
+
+def _spectral_forward(g_grid: torch.Tensor, op: torch.Tensor) -> torch.Tensor:
+    """(n, n, n): ``irfftn(sum_a op_a rfftn(g_a))`` of a (3, n, n, n) gradient grid;
+    ``op`` (3, n, n, n//2+1) complex, ``i u_a / (-2 pi |u|^2)``."""
+    n = g_grid.shape[-1]
+    gh = torch.fft.rfftn(g_grid, dim=(-3, -2, -1))               # (3, n, n, n//2+1)
+    return torch.fft.irfftn(torch.einsum("a...,a...->...", op, gh), s=(n, n, n),
+                            dim=(-3, -2, -1))
+
+
+def _spectral_adjoint(f_grad: torch.Tensor, op: torch.Tensor) -> torch.Tensor:
+    """(3, n, n, n): the adjoint of :func:`_spectral_forward` applied to an (n, n, n)
+    grid: ``irfftn(conj(op_a) rfftn(f_grad))``. The solve is a periodic convolution of
+    each component with a real kernel; its multiplier ``op_a`` is Hermitian (``i``
+    times a real function odd in the frequency), so the adjoint's multiplier is its
+    conjugate."""
+    n = f_grad.shape[-1]
+    fh = torch.fft.rfftn(f_grad, dim=(-3, -2, -1))
+    return torch.fft.irfftn(op.conj() * fh, s=(n, n, n), dim=(-3, -2, -1))
+
+
+class _Spectral(torch.autograd.Function):
+    """The periodic solve with its adjoint as the backward: autograd's backward of
+    ``rfftn`` is a full complex transform of a zero-filled spectrum, several times the
+    cost of the forward on a CPU; the adjoint takes one real transform and three
+    inverse ones. Twice differentiable (the backward is made of torch operations)."""
+
+    @staticmethod
+    def forward(ctx, g_grid, op):
+        ctx.save_for_backward(op)
+        return _spectral_forward(g_grid, op)
+
+    @staticmethod
+    def backward(ctx, f_grad):
+        (op,) = ctx.saved_tensors
+        return _spectral_adjoint(f_grad, op), None

@@ -359,3 +359,27 @@ def test_polish_with_the_stroke_strip_keeps_the_sphere():
                          polish=8, polish_strip=1.0)
     radius = np.linalg.norm(r.vertices, axis=1)
     assert abs(radius.mean() - 1.0) < 0.02 and radius.std() < 0.015, (radius.mean(), radius.std())
+
+
+def test_surface_samples_come_from_exactly_the_sign_change_cells():
+    """The cells sampled are those whose 8 corners hold both signs (the 2^3 max and
+    min pooling they replace), every sample on the zero set within a fraction of a
+    cell."""
+    import torch
+    import torch.nn.functional as F
+
+    from curvenet.neural.poisson import interpolate
+    from curvenet.neural.sampling import _in_some_cell
+    torch.manual_seed(0)
+    n = 24
+    c = (torch.arange(n, dtype=torch.float32) + 0.5) / n
+    X, Y, Z = torch.meshgrid(c, c, c, indexing="ij")
+    f = ((X - 0.5) ** 2 + (Y - 0.5) ** 2 + (Z - 0.5) ** 2).sqrt() - 0.3
+    f = f + 0.01 * torch.randn_like(f)
+    f[3, 4, 5] = 0.0                                   # a zero corner is neither sign
+    f5 = f[None, None]
+    cmin, cmax = -F.max_pool3d(-f5, 2, stride=1)[0, 0], F.max_pool3d(f5, 2, stride=1)[0, 0]
+    want = (cmin < 0) & (cmax > 0)
+    assert torch.equal(_in_some_cell(f > 0) & _in_some_cell(f < 0), want)
+    p = sample_surface_cells(f, 500, torch.Generator().manual_seed(1))
+    assert p.shape == (500, 3) and float(interpolate(f, p).abs().max()) < 0.5 / n
