@@ -36,7 +36,7 @@ def cad_report_lines(cad: dict) -> list:
         lines.append(f"cad: B-spline faces: {pr['n_exact']} of {pr['n_pieces']} pieces exact "
                      f"(level {pr['level']}, graded {max(pr['grades_used'], default=0)}), max "
                      f"deviation {pr['max_deviation']:.2e} of the diagonal")
-    if "valid" in fr:
+    if "shells" in fr:                  # STEP; a 3DM report has breps (and valid too)
         lines.append(f"cad: {fr['shells']} shells, {fr['solids']} solids, {fr['free_edges']} "
                      f"free edges, valid {fr['valid']}, sewing tolerance "
                      f"{cad['sew_tolerance']:.2e}")

@@ -1,5 +1,6 @@
 """STEP / 3DM export of the classical surface (optional extra curvenet[cad])."""
 
+import importlib.util
 import sys
 
 import numpy as np
@@ -289,6 +290,10 @@ def test_cli_step_explain(tmp_path, capsys):
                  "--no-progress"]) == 0
     out = capsys.readouterr().out
     assert "cad: 6 faces (6 plane)" in out and "valid True" in out
+    if importlib.util.find_spec("rhino3dm"):     # a 3DM report has no shells
+        assert main(["surface", str(src), "-o", str(tmp_path / "b.3dm"), "--explain",
+                     "--no-progress"]) == 0
+        assert "cad: 1 joined Breps, 1 closed, valid True" in capsys.readouterr().out
     src2 = tmp_path / "sheet.json"
     write_network(src2, shapes.grid_sheet().network)
     rep = tmp_path / "r.json"
