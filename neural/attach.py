@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 import scipy.sparse as sp
-from scipy.sparse.linalg import spsolve
+from scipy.sparse.linalg import splu
 
 __all__ = ["attach_to_strokes"]
 
@@ -83,5 +83,8 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
     beta = weight * alpha * h * h
     A = (L.T @ sp.diags(1.0 / m) @ L + alpha * sp.diags(m) + beta * (B.T @ B)).tocsc()
     rhs = alpha * (m[:, None] * V) + beta * (B.T @ S)
-    X = np.asarray(spsolve(A, rhs), np.float64).reshape(V.shape)
+    # symmetric positive definite: a symmetric ordering and no pivoting (Cholesky's fill)
+    lu = splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+              options={"SymmetricMode": True})
+    X = np.asarray(lu.solve(rhs), np.float64).reshape(V.shape)
     return X, {"samples": int(len(near)), "pulled": int(near.sum())}
