@@ -43,8 +43,12 @@ LINE_TOL = 1e-7
 #: curves on the surface made from the samples, :mod:`curvenet.cad.pcurves`).
 CAD_KINDS = ("plane", "cylinder", "cone", "sphere", "torus")
 #: Sewing tolerance as a fraction of the diagonal, never below twice the largest gap
-#: between neighbouring faces' borders.
+#: between the B-spline pieces' borders and the curves (when the shape has pieces) or
+#: twice the largest residual of the trimmed faces' surfaces.
 SEW_TOL = 1e-6
+#: Model units: how close an edge of a natural face must come to a point to be degenerate
+#: (a cone's apex, a sphere's pole).
+_DEGENERATE_TOL = 1e-7
 
 #: OpenCascade's surface types by the names the report uses.
 _KIND_NAMES = {"GeomAbs_Plane": "plane", "GeomAbs_Cylinder": "cylinder",
@@ -266,12 +270,58 @@ def analytic_face(surface, boundary, edges, *, tolerance: float, name: str, curv
         if abs(u0) > 1e-12:
             x = np.cos(u0) * surface.xdir + np.sin(u0) * surface.ydir
             face = _trimmed(replace(surface, xdir=x / np.linalg.norm(x)), wires, tolerance)
+        band = _full_band(surface, face, boundary, seam, tolerance)
+        if band is not None:
+            return band
     for k, w in enumerate(wires):
         sa = ShapeAnalysis_Wire(w, face, tolerance)
         if sa.CheckSelfIntersection():
             where = "outer loop" if k == 0 else f"hole {k}"
             raise CadInputError(f"{name}: its {where} crosses itself on its {surface.kind}")
     return face
+
+
+def _full_band(surface, face, boundary, seam: bool, tolerance: float):
+    """A cylinder, cone or sphere face bounded by one loop with a seam whose other edges
+    are parallels (a band between two circles, or a circle and an apex or pole), as its
+    natural face over one turn; else None.
+
+    Where such a loop meets an apex or a pole, ``u`` is undefined there, and
+    ``ShapeFix_Face`` closes the loop with a degenerate edge that runs the wrong way (the
+    seam's curve on the surface may come out slanted too): the face passes
+    ``BRepCheck`` but meshes badly, and sewing or NURBS conversion turn its curves into
+    a loop over two or three periods, which openNURBS rejects. The band is the surface
+    between its two heights over the full turn (the frame starts at the seam); sewing
+    joins its circles to the neighbours' edges, and the seam's own edge is a line of
+    the face.
+    """
+    from OCP.BRep import BRep_Tool
+    from OCP.BRepAdaptor import BRepAdaptor_Curve2d
+    from OCP.BRepBuilderAPI import BRepBuilderAPI_MakeFace
+    from OCP.TopAbs import TopAbs_EDGE
+    from OCP.TopExp import TopExp_Explorer
+    from OCP.TopoDS import TopoDS
+    if not seam or len(boundary) != 1 or surface.kind not in ("cylinder", "cone", "sphere"):
+        return None
+    uv, parallel = [], []      # points of every edge's curve on the face; the parallels' v
+    exp = TopExp_Explorer(face, TopAbs_EDGE)
+    while exp.More():
+        e = TopoDS.Edge(exp.Current())
+        exp.Next()
+        c = BRepAdaptor_Curve2d(e, face)
+        p = np.array([[q.X(), q.Y()] for q in (c.Value(t) for t in np.linspace(
+            c.FirstParameter(), c.LastParameter(), 9))])
+        uv.append(p)
+        if not (BRep_Tool.Degenerated_s(e) or BRep_Tool.IsClosed_s(e, face)):
+            parallel.append(p[:, 1])
+    v0, v1 = np.vstack(uv)[:, 1].min(), np.vstack(uv)[:, 1].max()
+    residual = surface.residual / (surface.radius if surface.kind == "sphere" else 1.0)
+    v_tol = max(10.0 * residual, 1e-6 * (v1 - v0))
+    if not all(np.abs(v - v0).max() <= v_tol or np.abs(v - v1).max() <= v_tol
+               for v in parallel):
+        return None                      # an edge is no parallel: the band is not the face
+    return BRepBuilderAPI_MakeFace(_geom_surface(surface), 0.0, 2.0 * np.pi, v0, v1,
+                                   _DEGENERATE_TOL).Face()
 
 
 def _loop_points(loop, curves) -> np.ndarray:
@@ -559,8 +609,13 @@ def _brep(model: CadModel, kinds, pieces: list):
     as their pieces (``pieces``: the faces of ``model.pieces``; patches with none are
     left out)."""
     diag = model.diagonal if model.diagonal > 0 else 1.0
-    tol = max(SEW_TOL * diag, 2.0 * model.gap)
     analytic = [k for k, s in enumerate(model.surfaces) if s is not None and s.kind in kinds]
+    # the pieces' borders lie up to the gap from the curves; trimmed faces' edges are the
+    # curves themselves, on their surfaces within the residual
+    trimmed = set(analytic)
+    with_pieces = any(int(k) not in trimmed for k in model.piece_patch)
+    tol = max([SEW_TOL * diag, 2.0 * model.gap if with_pieces else 0.0]
+              + [2.0 * model.surfaces[k].residual for k in analytic])
     used = {e for k in analytic for lp in model.boundaries[k] for e, _ in lp}
     edges = curve_edges(model.curves, model.ends, model.positions, used, diagonal=diag)
     faces, info, of_patch = [], [], {}
@@ -576,7 +631,6 @@ def _brep(model: CadModel, kinds, pieces: list):
         of_patch.setdefault(k, []).append(len(faces))
         faces.append(face)
         info.append({"patch": k, "kind": s.kind, "residual": float(s.residual / diag)})
-    trimmed = set(analytic)
     for pc, k in zip(pieces, model.piece_patch):
         if int(k) in trimmed:
             continue

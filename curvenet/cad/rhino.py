@@ -388,6 +388,62 @@ def _seams_on_sides(c2, trims, tis, surface) -> None:
             curve.Points[i] = rhino3dm.Point4d(x * w, y * w, 0.0, w)
 
 
+def _traced_tiny_loops(pts, c2, c3, edges, trims, loop_surfaces, tol: float) -> None:
+    """A closed edge that stays within ``tol`` of its vertex gets, as its curve, the 3D
+    image of its first trim, run from the vertex back to it.
+
+    openNURBS checks a closed edge's direction by the sign of the dot product of its end
+    tangents with those of each trim's image on its surface; on an edge no longer than a
+    few tolerances (a speck of a loop where strokes cross twice) both are noise within
+    the tolerance, and the signs disagree at one end. The new curve is a polyline
+    through the trim's image whose first and last segments leave and reach the vertex
+    along the image's end tangents, so it agrees with that trim by construction and lies
+    within the tolerance of the old one.
+
+    Parameters
+    ----------
+    pts : (V, 3) float64
+        The vertices.
+    c2, c3 : list of rhino3dm.NurbsCurve
+        Trim and edge curves; ``c3`` is changed in place.
+    edges, trims : list of dict
+        The tables of :func:`brep_bytes`.
+    loop_surfaces : list of rhino3dm.NurbsSurface
+        The surface of each loop (trims name their loop by ``li``).
+    tol : float
+        The edges' tolerance.
+    """
+    import rhino3dm
+    for ei, e in enumerate(edges):
+        if e["vi"][0] != e["vi"][1] or not e["ti"]:
+            continue
+        vertex = pts[e["vi"][0]]
+        if np.linalg.norm(_points3d(c3[ei], np.linspace(*e["dom"], 33)) - vertex,
+                          axis=1).max() > tol:
+            continue
+        first = trims[e["ti"][0]]
+        surface, trim = loop_surfaces[first["li"]], c2[first["c2i"]]
+        t0, t1 = first["dom"]
+        step = 1e-6 * (t1 - t0)
+        uv = _points3d(trim, np.r_[t0, t0 + step, np.linspace(t0, t1, 33)[1:-1], t1 - step, t1])
+        image = np.array([[p.X, p.Y, p.Z] for p in (surface.PointAt(u, v) for u, v, _ in uv)])
+        image = np.vstack([vertex, vertex + image[1] - image[0], image[2:-2],
+                           vertex + image[-2] - image[-1], vertex])
+        if first["rev"]:
+            image = image[::-1]
+        traced = rhino3dm.NurbsCurve(3, False, 2, len(image))
+        for i, p in enumerate(image):
+            traced.Points[i] = rhino3dm.Point4d(*p, 1.0)
+        for i, k in enumerate(np.linspace(*e["dom"], len(image))):
+            traced.Knots[i] = k
+        c3[ei] = traced
+
+
+def _points3d(curve, ts) -> np.ndarray:
+    """(len(ts), 3) float64: a rhino3dm curve's points at the parameters ``ts``."""
+    return np.array([[p.X, p.Y, p.Z] for p in (curve.PointAt(t) for t in ts)])
+
+
 def _domain(c) -> tuple:
     d = c.Domain
     return float(d.T0), float(d.T1)
@@ -481,6 +537,8 @@ def brep_bytes(shape, tolerance: float) -> bytes:
             loops.append({"ti": tis, "type": _OUTER if not lis else _INNER, "fi": fi - 1})
             lis.append(li)
         faces.append({"li": lis, "si": fi - 1, "rev": int(face0.Orientation() == TopAbs_REVERSED)})
+    _traced_tiny_loops(pts, c2, c3, edges, trims, [surfaces[lp["fi"]] for lp in loops],
+                       tolerance)
     for t in trims:
         if t["ei"] < 0:
             t["type"] = _SINGULAR
