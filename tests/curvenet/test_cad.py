@@ -223,6 +223,10 @@ def test_3dm_is_one_joined_closed_brep(tmp_path, make):
     # a sphere face whose loop crosses the seam of the NURBS conversion's domain: its
     # trims were evaluated off the surface (see _into_window)
     ("flowrep/spherecylinder", 1),
+    # a speck of a closed edge in a face's loop: openNURBS judges its direction by end
+    # tangents that are noise there (see _traced_tiny_loops); a minute each
+    pytest.param("flowrep/bottle", 1, marks=pytest.mark.slow),
+    pytest.param("flowrep/espresso", 11, marks=pytest.mark.slow),
 ])
 def test_3dm_of_public_networks_is_valid(tmp_path, data_dir, stem, breps):
     pytest.importorskip("rhino3dm")
