@@ -270,7 +270,7 @@ def analytic_face(surface, boundary, edges, *, tolerance: float, name: str, curv
         if abs(u0) > 1e-12:
             x = np.cos(u0) * surface.xdir + np.sin(u0) * surface.ydir
             face = _trimmed(replace(surface, xdir=x / np.linalg.norm(x)), wires, tolerance)
-        band = _full_band(surface, face, boundary, seam, tolerance)
+        band = _full_band(surface, face, boundary, seam)
         if band is not None:
             return band
     for k, w in enumerate(wires):
@@ -281,7 +281,7 @@ def analytic_face(surface, boundary, edges, *, tolerance: float, name: str, curv
     return face
 
 
-def _full_band(surface, face, boundary, seam: bool, tolerance: float):
+def _full_band(surface, face, boundary, seam: bool):
     """A cylinder, cone or sphere face bounded by one loop with a seam whose other edges
     are parallels (a band between two circles, or a circle and an apex or pole), as its
     natural face over one turn; else None.

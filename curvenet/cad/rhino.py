@@ -187,8 +187,7 @@ def _sampled_uv(curve, n: int = 33) -> np.ndarray:
     """(n, 2) float64: points of a 2D NURBS curve at ``n`` even parameters (a rational
     curve's control points may lie far off it)."""
     d = curve.Domain
-    return np.array([[p.X, p.Y] for p in (curve.PointAt(t)
-                                          for t in np.linspace(d.T0, d.T1, n))])
+    return _points3d(curve, np.linspace(d.T0, d.T1, n))[:, :2]
 
 
 def _iso(curve, surface) -> int:
