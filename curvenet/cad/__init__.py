@@ -1,11 +1,13 @@
 """B-rep output: STEP and 3DM through OpenCascade and rhino3dm (the ``[cad]`` extra).
 
-:mod:`.brep` builds the shape (shared edges, trimmed analytic faces, B-spline pieces,
-sewn solids), :mod:`.rhino` writes it as a joined 3DM Brep, :mod:`.export` as STEP;
+:mod:`.faces` makes the shared edges and the trimmed analytic faces, :mod:`.brep` sews
+them and the B-spline pieces into the shape, :mod:`.rhino` writes it as a joined 3DM
+Brep (its trims as openNURBS checks them: :mod:`.trims`), :mod:`.export` as STEP;
 :mod:`.occ` holds the helpers they share.
 """
 
-from .brep import CAD_KINDS, CadInputError, CadModel, TrimCheckError, brep_shape, face_kinds
+from .brep import CAD_KINDS, CadModel, brep_shape, face_kinds
+from .faces import CadInputError, TrimCheckError
 from .export import CAD_FORMATS, STEP_SCHEMAS, cad_model, read_step, write_cad, write_step
 from .occ import require_cad, shape_report
 from .rhino import read_3dm_breps, write_3dm

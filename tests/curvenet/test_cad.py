@@ -221,10 +221,10 @@ def test_3dm_is_one_joined_closed_brep(tmp_path, make):
     # degenerate edge left out and the pole trims left put on their sides
     ("mingzou/SGA_Submarine", 3),
     # a sphere face whose loop crosses the seam of the NURBS conversion's domain: its
-    # trims were evaluated off the surface (see _into_window)
+    # trims were evaluated off the surface (see into_window)
     ("flowrep/spherecylinder", 1),
     # a speck of a closed edge in a face's loop: openNURBS judges its direction by end
-    # tangents that are noise there (see _traced_tiny_loops); a minute each
+    # tangents that are noise there (see traced_tiny_loops); a minute each
     pytest.param("flowrep/bottle", 1, marks=pytest.mark.slow),
     pytest.param("flowrep/espresso", 11, marks=pytest.mark.slow),
 ])
@@ -316,21 +316,21 @@ def test_cli_step_explain(tmp_path, capsys):
 def test_trims_and_a_closed_surface_are_put_in_one_period(u0, u1):
     """OpenCascade's curves on a closed surface may lie in another period than the
     surface's NURBS domain (flowrep/spherecylinder: a loop at u in [1.7, 8.0] on a domain
-    [-2.1, 4.2] made its 3DM invalid); after ``_into_window`` the shifted trims lie in the
+    [-2.1, 4.2] made its 3DM invalid); after ``into_window`` the shifted trims lie in the
     domain and map to the same points of the surface."""
     pytest.importorskip("rhino3dm")
     pytest.importorskip("OCP")
     from OCP.Geom import Geom_CylindricalSurface, Geom_RectangularTrimmedSurface
     from OCP.GeomConvert import GeomConvert
     from OCP.gp import gp_Ax3
-    from curvenet.cad.rhino import _into_window
+    from curvenet.cad.trims import into_window
     def converted():        # a closed, non-periodic NURBS cylinder on u in [4.28, 10.57]
         return GeomConvert.SurfaceToBSplineSurface_s(Geom_RectangularTrimmedSurface(
             Geom_CylindricalSurface(gp_Ax3(), 1.0), -2.0, -2.0 + 2 * np.pi, 0.0, 1.0))
     bs, periodic = converted(), converted()
     periodic.SetUPeriodic()         # evaluates any u as the same point of its period
     uv = np.column_stack([np.linspace(u0, u1, 50), np.linspace(0.2, 0.8, 50)])
-    shift = _into_window(bs, uv)
+    shift = into_window(bs, uv)
     lo, hi, _, _ = bs.Bounds()
     moved = uv + shift
     assert lo - 1e-9 <= moved[:, 0].min() and moved[:, 0].max() <= hi + 1e-9
@@ -358,7 +358,7 @@ def test_a_speck_of_a_closed_edge_runs_with_its_trim(rev):
     trim's image's as the ``rev`` flag says, and it stays within the tolerance. A closed
     edge longer than the tolerance is left as it is."""
     rhino3dm = pytest.importorskip("rhino3dm")
-    from curvenet.cad.rhino import _traced_tiny_loops
+    from curvenet.cad.trims import traced_tiny_loops
     plane = rhino3dm.NurbsSurface.Create(3, False, 2, 2, 2, 2)
     for i, j in np.ndindex(2, 2):
         plane.Points[i, j] = rhino3dm.Point4d(float(i), float(j), 0.0, 1.0)
@@ -378,7 +378,7 @@ def test_a_speck_of_a_closed_edge_runs_with_its_trim(rev):
     trims = [{"c2i": k, "ei": k, "vi": [k, k], "rev": rev, "li": 0, "dom": (0.0, 1.0)}
              for k in (0, 1)]
     big = c3[1]
-    _traced_tiny_loops(pts, c2, c3, edges, trims, [plane], tol)
+    traced_tiny_loops(pts, c2, c3, edges, trims, [plane], tol)
     assert c3[1] is big
     edge, trim = c3[0], c2[0]
     sign = -1.0 if rev else 1.0
