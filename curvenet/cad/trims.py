@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = ["iso", "into_window", "sampled_uv", "shifted", "close_loop", "singular_lines",
-           "poles_only", "seams_on_sides", "traced_tiny_loops", "domain"]
+           "poles_only", "seams_on_sides", "traced_tiny_loops", "domain", "polyline"]
 
 #: ``ON_Surface::ISO`` flags: interior ``u`` / ``v`` = constant, the W, S, E, N sides.
 _X_ISO, _Y_ISO, _W_ISO, _S_ISO, _E_ISO, _N_ISO = 1, 2, 3, 4, 5, 6
@@ -169,17 +169,14 @@ def singular_lines(c2, trims, tis) -> None:
     """A singular trim's curve made the straight line along the collapsed side, from the
     previous trim's end to the next one's start (NURBS conversion can leave it a point,
     which openNURBS rejects)."""
-    import rhino3dm
     for k, t in enumerate(tis):
         if trims[t]["ei"] >= 0:
             continue
         prev, nxt = c2[trims[tis[k - 1]]["c2i"]], c2[trims[tis[(k + 1) % len(tis)]]["c2i"]]
         a, b = prev.Points[len(prev.Points) - 1], nxt.Points[0]
         t0, t1 = trims[t]["dom"]
-        line = rhino3dm.NurbsCurve(2, False, 2, 2)
-        line.Points[0] = rhino3dm.Point4d(a.X / a.W, a.Y / a.W, 0.0, 1.0)
-        line.Points[1] = rhino3dm.Point4d(b.X / b.W, b.Y / b.W, 0.0, 1.0)
-        line.Knots[0], line.Knots[1] = t0, (t1 if t1 > t0 else t0 + 1.0)
+        line = polyline([[a.X / a.W, a.Y / a.W, 0.0], [b.X / b.W, b.Y / b.W, 0.0]], 2,
+                        (t0, t1 if t1 > t0 else t0 + 1.0))
         c2[trims[t]["c2i"]] = line
         trims[t]["dom"] = domain(line)
 
@@ -263,7 +260,6 @@ def traced_tiny_loops(pts, c2, c3, edges, trims, loop_surfaces, tol: float) -> N
     tol : float
         The edges' tolerance.
     """
-    import rhino3dm
     for ei, e in enumerate(edges):
         if e["vi"][0] != e["vi"][1] or not e["ti"]:
             continue
@@ -281,12 +277,19 @@ def traced_tiny_loops(pts, c2, c3, edges, trims, loop_surfaces, tol: float) -> N
                            vertex + image[-2] - image[-1], vertex])
         if first["rev"]:
             image = image[::-1]
-        traced = rhino3dm.NurbsCurve(3, False, 2, len(image))
-        for i, p in enumerate(image):
-            traced.Points[i] = rhino3dm.Point4d(*p, 1.0)
-        for i, k in enumerate(np.linspace(*e["dom"], len(image))):
-            traced.Knots[i] = k
-        c3[ei] = traced
+        c3[ei] = polyline(image, 3, e["dom"])
+
+
+def polyline(points, dim: int, dom):
+    """A degree-1 rhino3dm ``NurbsCurve`` of dimension ``dim`` through ``points`` ((k, 3)
+    float64; z ignored when ``dim`` is 2), its knots spread evenly over ``dom`` = (t0, t1)."""
+    import rhino3dm
+    c = rhino3dm.NurbsCurve(dim, False, 2, len(points))
+    for i, p in enumerate(np.asarray(points, np.float64).tolist()):
+        c.Points[i] = rhino3dm.Point4d(*p, 1.0)
+    for i, k in enumerate(np.linspace(*dom, len(points))):
+        c.Knots[i] = float(k)
+    return c
 
 
 def _points3d(curve, ts) -> np.ndarray:

@@ -339,17 +339,6 @@ def test_trims_and_a_closed_surface_are_put_in_one_period(u0, u1):
         assert p.Distance(q) < 1e-9
 
 
-def _nurbs_curve(points, dim, domain):
-    """A degree-1 rhino3dm NurbsCurve through ``points`` (k, 3) on ``domain``."""
-    import rhino3dm
-    c = rhino3dm.NurbsCurve(dim, False, 2, len(points))
-    for i, p in enumerate(points):
-        c.Points[i] = rhino3dm.Point4d(*map(float, p), 1.0)
-    for i, k in enumerate(np.linspace(*domain, len(points))):
-        c.Knots[i] = k
-    return c
-
-
 @pytest.mark.parametrize("rev", [0, 1])
 def test_a_speck_of_a_closed_edge_runs_with_its_trim(rev):
     """A closed edge within the tolerance of its vertex whose curve runs against its
@@ -358,7 +347,7 @@ def test_a_speck_of_a_closed_edge_runs_with_its_trim(rev):
     trim's image's as the ``rev`` flag says, and it stays within the tolerance. A closed
     edge longer than the tolerance is left as it is."""
     rhino3dm = pytest.importorskip("rhino3dm")
-    from curvenet.cad.trims import traced_tiny_loops
+    from curvenet.cad.trims import polyline, traced_tiny_loops
     plane = rhino3dm.NurbsSurface.Create(3, False, 2, 2, 2, 2)
     for i, j in np.ndindex(2, 2):
         plane.Points[i, j] = rhino3dm.Point4d(float(i), float(j), 0.0, 1.0)
@@ -371,9 +360,9 @@ def test_a_speck_of_a_closed_edge_runs_with_its_trim(rev):
         uv = np.c_[0.5 + r * np.cos(t) - r, 0.5 + r * np.sin(t), 0 * t]
         loops.append((uv, np.c_[uv[:, :2], 0.4 * tol * np.sin(3 * t)]))   # edge off-plane
     pts = np.array([[0.5, 0.5, 0.0], [0.5, 0.5, 0.0]])
-    c2 = [_nurbs_curve(uv, 2, (0, 1)) for uv, _ in loops]
+    c2 = [polyline(uv, 2, (0, 1)) for uv, _ in loops]
     # the edge runs against the trim when rev = 0 and with it when rev = 1
-    c3 = [_nurbs_curve(e if rev else e[::-1], 3, (0, 1)) for _, e in loops]
+    c3 = [polyline(e if rev else e[::-1], 3, (0, 1)) for _, e in loops]
     edges = [{"vi": [k, k], "ti": [k], "dom": (0.0, 1.0)} for k in (0, 1)]
     trims = [{"c2i": k, "ei": k, "vi": [k, k], "rev": rev, "li": 0, "dom": (0.0, 1.0)}
              for k in (0, 1)]
