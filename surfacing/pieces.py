@@ -3,11 +3,29 @@
 The paper samples every curve with the same user-set ``N`` segments. Long or winding
 curves of real networks need more: :func:`curve_pieces` gives each curve a number of
 *pieces* of ``N`` segments, from its length and from how much it turns at the scale of
-the pieces, and :func:`equalise_strips` raises the counts so that opposite curves of
-every four-curve loop agree (the loop stays a regular grid).
+the pieces, and :func:`equalise_pieces` raises the counts so that opposite curves of
+every four-curve loop agree (the loop stays a regular grid) and so that curves that
+continue each other through a regular junction keep their densities of control points
+(pieces per length) within :data:`DENSITY_RATIO`, as far as a curve's own turning
+allows (a piece per ``PIECE_TURN / DENSITY_RATIO`` degrees).
+
+Why the continuations: the fit's fairness operator (:func:`surfacing.fit.fairness_matrix`,
+the umbrella Laplacian) measures a curve's bending per control segment, so it reads a
+jump of density along a curve as a jump of curvature and bends the surface to smooth it
+out. A torus drawn as three meridians and three rings has meridian pieces turning by
+120 degrees, exactly :data:`PIECE_TURN`; drawn by hand, some of them turn a little more
+and get two pieces where their continuations have one, and the least-squares fit came
+out flattened between the rings. The raise is
+bounded by what the curve's own turning would ask for at a threshold lowered by the same
+ratio: the pieces' threshold becomes a band inside which the continuations decide. Raised
+without that bound, straight curves of hand-drawn sketches took the density of the
+winding ones they continue, and their fits followed more of the strokes' wobble (a
+sewing machine's body came out wrinkled).
 """
 
 from __future__ import annotations
+
+import heapq
 
 import numpy as np
 import scipy.sparse as sp
@@ -16,8 +34,9 @@ from scipy.sparse.csgraph import connected_components
 from curvenet.core.geometry import arc_length, arc_length_params, resample_polyline
 from curvenet.core.tolerances import DIVISION_GUARD
 
-__all__ = ["curve_pieces", "equalise_strips", "PIECE_LENGTH", "PIECE_TURN", "TURN_SEGMENTS",
-           "TURN_SCALES", "PIECE_ROUNDING"]
+__all__ = ["curve_pieces", "equalise_pieces", "continuations",
+           "PIECE_LENGTH", "PIECE_TURN", "TURN_SEGMENTS", "TURN_SCALES", "PIECE_ROUNDING",
+           "DENSITY_RATIO"]
 
 #: Adaptive pieces: a curve gets one more piece of ``N`` segments per this many times the
 #: median curve length ...
@@ -35,6 +54,11 @@ TURN_SEGMENTS = 8
 TURN_SCALES = 4
 #: Ratios within this of an integer count as that integer (equal curves get equal pieces).
 PIECE_ROUNDING = 1e-9
+#: Curves that continue each other through a regular junction keep densities (pieces per
+#: length) within this factor: the rounding of ``n`` against ``n + 1`` pieces for ``n >=
+#: 2`` is allowed, one piece against two is not. Exact equality would ratchet up: curves
+#: of slightly different lengths cannot have equal integer densities.
+DENSITY_RATIO = 1.5
 
 
 def _turning(curve: np.ndarray, n: int) -> float:
@@ -89,30 +113,32 @@ def _turnings(curves: list, n: int, params=None) -> np.ndarray:
     return turn.sum(1) * n / (n - 1)
 
 
-def _turns_pieces(curves: list) -> np.ndarray:
+def _turns_pieces(curves: list, turn: float = PIECE_TURN) -> np.ndarray:
     """Pieces each curve (``(m_i, 3)``, ``m_i >= 2``) asks for: ``(C,) int64``.
 
     At scale ``s`` (1 .. TURN_SCALES) a curve is resampled at ``TURN_SEGMENTS * s``
-    segments; when it turns by more than ``PIECE_TURN * s`` there, ``s`` pieces cannot
-    follow it and the scale asks for ``ceil(turning / PIECE_TURN)``; otherwise it asks
+    segments; when it turns by more than ``turn * s`` there (``turn``:
+    :data:`PIECE_TURN` unless given), ``s`` pieces cannot follow it and the scale asks
+    for ``ceil(turning / turn)``; otherwise it asks
     for nothing (coarser scales decide whether fewer are enough). Stroke wobble below a
     piece's scale therefore adds nothing to a curve that the coarse scales find smooth.
     """
     need = np.ones(len(curves), np.int64)
     params = [arc_length_params(c) for c in curves]
     for s in range(1, TURN_SCALES + 1):
-        t = _turnings(curves, TURN_SEGMENTS * s, params) / PIECE_TURN
+        t = _turnings(curves, TURN_SEGMENTS * s, params) / turn
         over = t > s * (1 + PIECE_ROUNDING)
         need[over] = np.maximum(need[over], np.ceil(t[over] - PIECE_ROUNDING).astype(np.int64))
     return need
 
 
-def curve_pieces(curves: list, closed: np.ndarray) -> np.ndarray:
+def curve_pieces(curves: list, closed: np.ndarray, turn: float = PIECE_TURN) -> np.ndarray:
     """Pieces (of ``N`` control segments each) per curve for adaptive resolution.
 
     ``max(1, ceil(length / (PIECE_LENGTH * median length)), turning pieces)``, at least 2
     for a closed curve; the turning pieces are what the curve's turning asks for at the
-    scales of one to :data:`TURN_SCALES` pieces (:func:`_turns_pieces`).
+    scales of one to :data:`TURN_SCALES` pieces (:func:`_turns_pieces`), a piece per
+    ``turn`` degrees (:data:`PIECE_TURN` unless given).
 
     Returns
     -------
@@ -120,7 +146,7 @@ def curve_pieces(curves: list, closed: np.ndarray) -> np.ndarray:
     """
     lengths = np.array([arc_length(c) for c in curves])
     med = float(np.median(lengths)) if len(lengths) else 1.0
-    turn = _turns_pieces([np.asarray(c, dtype=np.float64) for c in curves])
+    turn = _turns_pieces([np.asarray(c, dtype=np.float64) for c in curves], turn)
     # a curve exactly PIECE_LENGTH medians long (rounding noise aside) stays one piece
     m = np.maximum(np.ceil(lengths / (PIECE_LENGTH * max(med, DIVISION_GUARD)) - PIECE_ROUNDING),
                    turn)
@@ -128,20 +154,121 @@ def curve_pieces(curves: list, closed: np.ndarray) -> np.ndarray:
     return np.where(closed, np.maximum(m, 2), m)
 
 
-def equalise_strips(m: np.ndarray, loops: list) -> np.ndarray:
-    """Raise piece counts so opposite curves of every four-curve loop agree.
-
-    Opposite curves of four-curve loops are joined into classes (the quad strips of
-    the layout); every curve of a class takes the class maximum, so those loops stay
-    regular ``p x q`` grids instead of falling back to a centre split.
-    """
-    C = len(m)
+def _strips(C: int, loops: list) -> np.ndarray:
+    """Strip label ``(C,) int64`` of each curve: opposite curves of four-curve loops
+    joined (the quad strips of the layout)."""
     pairs = [(lp[k][0], lp[k + 2][0]) for lp in loops if len(lp) == 4 for k in (0, 1)]
     if not pairs:
-        return m
+        return np.arange(C, dtype=np.int64)
     pr = np.array(pairs, dtype=np.int64)
     g = sp.coo_matrix((np.ones(len(pr)), (pr[:, 0], pr[:, 1])), shape=(C, C))
-    _, lab = connected_components(g, directed=False)
-    best = np.zeros(lab.max() + 1, dtype=np.int64)
+    return connected_components(g, directed=False)[1].astype(np.int64)
+
+
+def continuations(loops: list, jend: np.ndarray) -> np.ndarray:
+    """Pairs of curves that continue each other through a regular junction.
+
+    A junction is regular when exactly four ends of four different curves meet there and
+    the loops join them in a ring (each end is next to two others in the loops, as at a
+    crossing of two grid lines); the two ends not next to each other continue each
+    other.
+
+    Parameters
+    ----------
+    loops : list of list of (int, bool)
+        Each loop: (curve index, traversed forward) in traversal order.
+    jend : (C, 2) int64
+        Junction of each curve's start and end.
+
+    Returns
+    -------
+    (k, 2) int64
+        Curve pairs, each once.
+    """
+    jend = np.asarray(jend, dtype=np.int64)
+    at = jend.ravel()                                   # junction of end 2i (start), 2i + 1
+    near = {}                                           # end -> ends next to it in a loop
+    for lp in loops:            # the end of one curve meets the start of the next
+        n = len(lp)
+        for k in range(n):
+            (a, fa), (b, fb) = lp[k], lp[(k + 1) % n]
+            ea, eb = 2 * a + int(fa), 2 * b + int(not fb)
+            if a != b:
+                near.setdefault(ea, set()).add(eb)
+                near.setdefault(eb, set()).add(ea)
+    ends_at = np.bincount(at)
+    out = []
+    for x, nx in near.items():
+        if ends_at[at[x]] != 4 or len(nx) != 2:
+            continue
+        far = set().union(*(near[e] for e in nx)) - {x}     # across x's two neighbours
+        if len(far) != 1:
+            continue
+        y = far.pop()
+        if x < y and near[y] == nx and len({x // 2, y // 2, *(e // 2 for e in nx)}) == 4:
+            out.append((x // 2, y // 2))
+    return np.array(out, np.int64).reshape(-1, 2)
+
+
+def equalise_pieces(m: np.ndarray, loops: list, lengths: np.ndarray, jend: np.ndarray,
+                    most: np.ndarray) -> np.ndarray:
+    """Raise piece counts along quad strips and between continuing curves.
+
+    Opposite curves of four-curve loops are joined into classes (the quad strips of the
+    layout); every curve of a class takes the class maximum, so those loops stay
+    regular ``p x q`` grids instead of falling back to a centre split.
+
+    A curve whose density is more than :data:`DENSITY_RATIO` below its continuation's
+    (:func:`continuations`) takes ``ceil(length * density / DENSITY_RATIO)`` pieces, but
+    never more than the continuation has (a short curve's one piece is no density to
+    pass on: a curve of 1% of its neighbour's length would give the neighbour a hundred)
+    nor more than ``most`` allows it; its strip follows. Raised widest first, like
+    Dijkstra's search: a strip's count, once the largest left, is final (what it passes
+    on is no larger), so every strip is settled once and the cost is linear in the pairs
+    (up to the heap's logarithm).
+
+    Parameters
+    ----------
+    m : (C,) int64
+        Pieces per curve (:func:`curve_pieces`).
+    loops : list of list of (int, bool)
+    lengths : (C,) float64
+        Arc length of each curve.
+    jend : (C, 2) int64
+        Junction of each curve's start and end.
+    most : (C,) int64
+        The most pieces a continuation may give each curve: :func:`curve_pieces` with
+        ``turn = PIECE_TURN / DENSITY_RATIO``.
+
+    Returns
+    -------
+    (C,) int64
+    """
+    m = np.asarray(m, np.int64)
+    lab = _strips(len(m), loops)
+    best = np.zeros(lab.max() + 1 if len(lab) else 0, dtype=np.int64)
     np.maximum.at(best, lab, m)
+    pairs = continuations(loops, jend)
+    if len(pairs):
+        x = np.r_[pairs[:, 0], pairs[:, 1]]               # x continues y, both ways
+        y = np.r_[pairs[:, 1], pairs[:, 0]]
+        length = np.maximum(np.asarray(lengths, np.float64), DIVISION_GUARD)
+        ratio = length[x] / length[y] / DENSITY_RATIO
+        order = np.argsort(lab[y], kind="stable")
+        x, ratio = x[order], ratio[order]
+        cap = np.asarray(most, np.int64)[x]
+        start = np.searchsorted(lab[y][order], np.arange(len(best) + 1))
+        heap = [(-int(v), int(c)) for c, v in enumerate(best)]
+        heapq.heapify(heap)
+        while heap:
+            v, c = heapq.heappop(heap)
+            if -v != best[c]:
+                continue                                    # raised since it was pushed
+            s0, s1 = start[c], start[c + 1]
+            need = np.minimum(np.minimum(np.ceil(ratio[s0:s1] * -v - PIECE_ROUNDING), -v),
+                              cap[s0:s1]).astype(np.int64)
+            for t, k in zip(lab[x[s0:s1]], need):
+                if k > best[t]:
+                    best[t] = k
+                    heapq.heappush(heap, (-int(k), int(t)))
     return best[lab]

@@ -51,10 +51,10 @@ def test_auto_replaces_walls_by_the_faces_that_cover_as_much(basis_first):
 
 
 def test_curves_of_three_patches_alone_keep_the_first_selection(basis_first):
-    # a fat torus's basis, surfaced by the least-squares fit: no wall, curves in three
+    # a torus's basis, surfaced by the least-squares fit: no wall, curves in three
     # patches; the check passes it (the swept fit, auto's choice, bends some of these
     # patches into walls, which the check then replaces by the faces)
-    shape = shapes.torus(1.0, 0.6, n_u=4, n_v=3)
+    shape = shapes.torus(1.0, 0.4, n_u=4, n_v=2)
     res = curvenet.surface(shape.sketch(), classical_options={"fit": "lsq"})
     check = res.decision.check
     assert check["walls"] == {"basis": 0} and check["nonmanifold"] > 0

@@ -136,6 +136,60 @@ def test_adaptive_pieces_follow_quad_strips():
     assert cm.patch_kind == ["grid"]
 
 
+def _grid_of_four(lengths_up):
+    """A 2 x 2 grid of quad loops on junctions ``(i, j)``, ``i, j`` in 0..2: horizontal
+    curves ``h(i, j)`` to ``(i + 1, j)``, vertical ``v(i, j)`` to ``(i, j + 1)`` of the
+    given heights per row ``j``. Returns (loops, jend, lengths, curve ids)."""
+    ids, jend, lengths = {}, [], []
+    for kind in "hv":
+        for i in range(3 if kind == "v" else 2):
+            for j in range(2 if kind == "v" else 3):
+                ids[kind, i, j] = len(jend)
+                a = 3 * i + j
+                jend.append((a, a + 3) if kind == "h" else (a, a + 1))
+                lengths.append(1.0 if kind == "h" else lengths_up[j])
+    loops = [[(ids["h", i, j], True), (ids["v", i + 1, j], True),
+              (ids["h", i, j + 1], False), (ids["v", i, j], False)]
+             for i in range(2) for j in range(2)]
+    return loops, np.array(jend), np.array(lengths), ids
+
+
+def test_continuing_curves_keep_their_density():
+    """A quad strip with twice the control points of the strip it continues into reads,
+    to the umbrella fairness, as a jump of curvature: the continuing strip follows."""
+    from curvenet.surfacing.pieces import continuations, equalise_pieces
+    loops, jend, lengths, ids = _grid_of_four([1.0, 1.0])
+    # only the centre junction is a crossing of four curves
+    pairs = {tuple(sorted(p)) for p in continuations(loops, jend).tolist()}
+    assert pairs == {tuple(sorted((ids["h", 0, 1], ids["h", 1, 1]))),
+                     tuple(sorted((ids["v", 1, 0], ids["v", 1, 1])))}
+    m = np.ones(len(jend), np.int64)
+    m[ids["v", 1, 0]] = 2                    # one piece of the middle line turns more
+    up = [ids["v", i, j] for i in range(3) for j in range(2)]
+    strips = equalise_pieces(m, loops, lengths, jend, m)       # no curve may be raised
+    assert sorted(strips[up]) == [1, 1, 1, 2, 2, 2]          # the lower strip alone
+    out = equalise_pieces(m, loops, lengths, jend, np.full(len(jend), 3))
+    assert (out[up] == 2).all()
+    assert (out[[ids["h", i, j] for i in range(2) for j in range(3)]] == 1).all()
+    # a curve whose own turning asks for one piece even at the lowered threshold (a
+    # straight line continuing a winding one) keeps it
+    most = np.full(len(jend), 3)
+    most[ids["v", 1, 1]] = 1
+    kept = equalise_pieces(m, loops, lengths, jend, most)
+    assert kept[ids["v", 1, 1]] == 1 and kept[ids["v", 1, 0]] == 2
+
+
+def test_a_short_curve_passes_on_no_more_pieces_than_it_has():
+    """A curve of 1% of its continuation's length with two pieces: the continuation takes
+    two, not the 134 its density would ask for."""
+    from curvenet.surfacing.pieces import equalise_pieces
+    loops, jend, lengths, ids = _grid_of_four([0.01, 1.0])
+    m = np.ones(len(jend), np.int64)
+    m[ids["v", 1, 0]] = 2
+    out = equalise_pieces(m, loops, lengths, jend, np.full(len(jend), 200))
+    assert out.max() == 2 and out[ids["v", 1, 1]] == 2
+
+
 def test_stroke_wobble_does_not_count_as_winding():
     # a quarter circle turns 90 degrees; a hand-drawn one wobbles (here a smooth offset
     # of 1% of its length, three periods: the scale of the re-drawn torus's strokes),
