@@ -232,7 +232,7 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
         above ``crease_angle`` degrees become creases too (None: labelled ones only).
     resolution : int
         Control-polygon segments per curve piece (>= 2, odd rounded up to even); long
-        or winding curves get several pieces (:func:`surfacing.pieces.curve_pieces`).
+        or winding curves get several pieces (:func:`surfacing.pieces.piece_counts`).
     subdiv : int or None
         Catmull-Clark levels for the output mesh (>= 0); None chooses the level from
         ``edge_length`` (see :func:`density_subdiv`, at most :data:`DEFAULT_MAX_FACES`

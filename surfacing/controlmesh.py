@@ -2,7 +2,7 @@
 
 Every network curve is resampled into ``N`` equal-arc-length segments (``2 N`` for a
 closed curve, one whose two ends are the same junction; with ``adaptive`` a multiple
-of ``N`` for long or winding curves, see :func:`.pieces.curve_pieces`), and the samples become
+of ``N`` for long or winding curves, see :func:`.pieces.piece_counts`), and the samples become
 control vertices shared by every patch that uses the curve. Each loop is then filled
 with quads:
 
@@ -49,9 +49,9 @@ from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from .coons import coons_eval, coons_grid
-from curvenet.core.geometry import arc_length, resample_polyline
+from curvenet.core.geometry import resample_polyline
 from curvenet.core.tolerances import DIVISION_GUARD
-from .pieces import DENSITY_RATIO, PIECE_TURN, curve_pieces, equalise_pieces
+from .pieces import equalise_pieces, piece_counts
 from .sides import DEFAULT_STRAIGHT_ANGLE, group_sides
 from .sweep import sweep_grid
 
@@ -272,7 +272,7 @@ def build_control_mesh(curves, loops, resolution: int = 4, *,
         Repair loop orientation first (:func:`orient_loops`).
     adaptive : bool
         Give long or winding curves several pieces of ``N`` segments
-        (:func:`curve_pieces`), equalised along the quad strips of four-curve loops and
+        (:func:`.pieces.piece_counts`), equalised along the quad strips of four-curve loops and
         between curves that continue each other (:func:`.pieces.equalise_pieces`);
         False: ``N`` per curve (``2 N`` if closed), as in the paper.
 
@@ -299,9 +299,8 @@ def build_control_mesh(curves, loops, resolution: int = 4, *,
     jend, jpos = _junctions(curves, loops, diag)
     closed = jend[:, 0] == jend[:, 1]
     if adaptive:
-        lengths = np.array([arc_length(c) for c in curves])
-        most = curve_pieces(curves, closed, turn=PIECE_TURN / DENSITY_RATIO)
-        k_c = N * equalise_pieces(curve_pieces(curves, closed), loops, lengths, jend, most)
+        m, most, lengths = piece_counts(curves, closed)
+        k_c = N * equalise_pieces(m, loops, lengths, jend, most)
     else:
         k_c = N * np.where(closed, 2, 1)
     curve_pos, curve_vids, samples = _sample_curves(curves, jend, jpos, k_c)

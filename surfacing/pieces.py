@@ -1,7 +1,7 @@
 """How many control segments each curve gets (Orbay & Kara 2011, Sec. 4.2, adaptive).
 
 The paper samples every curve with the same user-set ``N`` segments. Long or winding
-curves of real networks need more: :func:`curve_pieces` gives each curve a number of
+curves of real networks need more: :func:`piece_counts` gives each curve a number of
 *pieces* of ``N`` segments, from its length and from how much it turns at the scale of
 the pieces, and :func:`equalise_pieces` raises the counts so that opposite curves of
 every four-curve loop agree (the loop stays a regular grid) and so that curves that
@@ -34,7 +34,7 @@ from scipy.sparse.csgraph import connected_components
 from curvenet.core.geometry import arc_length, arc_length_params, resample_polyline
 from curvenet.core.tolerances import DIVISION_GUARD
 
-__all__ = ["curve_pieces", "equalise_pieces", "continuations",
+__all__ = ["piece_counts", "equalise_pieces", "continuations",
            "PIECE_LENGTH", "PIECE_TURN", "TURN_SEGMENTS", "TURN_SCALES", "PIECE_ROUNDING",
            "DENSITY_RATIO"]
 
@@ -113,45 +113,58 @@ def _turnings(curves: list, n: int, params=None) -> np.ndarray:
     return turn.sum(1) * n / (n - 1)
 
 
-def _turns_pieces(curves: list, turn: float = PIECE_TURN) -> np.ndarray:
-    """Pieces each curve (``(m_i, 3)``, ``m_i >= 2``) asks for: ``(C,) int64``.
-
-    At scale ``s`` (1 .. TURN_SCALES) a curve is resampled at ``TURN_SEGMENTS * s``
-    segments; when it turns by more than ``turn * s`` there (``turn``:
-    :data:`PIECE_TURN` unless given), ``s`` pieces cannot follow it and the scale asks
-    for ``ceil(turning / turn)``; otherwise it asks
-    for nothing (coarser scales decide whether fewer are enough). Stroke wobble below a
-    piece's scale therefore adds nothing to a curve that the coarse scales find smooth.
-    """
-    need = np.ones(len(curves), np.int64)
+def _scale_turnings(curves: list) -> np.ndarray:
+    """Turning (degrees) of each curve (``(m_i, 3)``, ``m_i >= 2``) resampled at
+    ``TURN_SEGMENTS * s`` segments, ``s`` = 1 .. TURN_SCALES: ``(TURN_SCALES, C) float64``."""
+    curves = [np.asarray(c, dtype=np.float64) for c in curves]
     params = [arc_length_params(c) for c in curves]
-    for s in range(1, TURN_SCALES + 1):
-        t = _turnings(curves, TURN_SEGMENTS * s, params) / turn
+    return np.array([_turnings(curves, TURN_SEGMENTS * s, params)
+                     for s in range(1, TURN_SCALES + 1)]).reshape(TURN_SCALES, len(curves))
+
+
+def _turns_pieces(turnings: np.ndarray, turn: float) -> np.ndarray:
+    """Pieces each curve asks for at a piece per ``turn`` degrees: ``(C,) int64``.
+
+    ``turnings`` is :func:`_scale_turnings`. At scale ``s`` a curve that turns by more
+    than ``turn * s`` cannot be followed by ``s`` pieces, and the scale asks for
+    ``ceil(turning / turn)``; otherwise it asks for nothing (coarser scales decide
+    whether fewer are enough). Stroke wobble below a piece's scale therefore adds
+    nothing to a curve that the coarse scales find smooth.
+    """
+    need = np.ones(turnings.shape[1], np.int64)
+    for s, row in enumerate(turnings, start=1):
+        t = row / turn
         over = t > s * (1 + PIECE_ROUNDING)
         need[over] = np.maximum(need[over], np.ceil(t[over] - PIECE_ROUNDING).astype(np.int64))
     return need
 
 
-def curve_pieces(curves: list, closed: np.ndarray, turn: float = PIECE_TURN) -> np.ndarray:
-    """Pieces (of ``N`` control segments each) per curve for adaptive resolution.
+def piece_counts(curves: list, closed: np.ndarray) -> tuple:
+    """Pieces (of ``N`` control segments each) per curve for adaptive resolution, the
+    most a continuation may raise them to, and the curves' lengths.
 
-    ``max(1, ceil(length / (PIECE_LENGTH * median length)), turning pieces)``, at least 2
-    for a closed curve; the turning pieces are what the curve's turning asks for at the
-    scales of one to :data:`TURN_SCALES` pieces (:func:`_turns_pieces`), a piece per
-    ``turn`` degrees (:data:`PIECE_TURN` unless given).
+    Pieces: ``max(1, ceil(length / (PIECE_LENGTH * median length)), turning pieces)``,
+    at least 2 for a closed curve; the turning pieces are what the curve's turning asks
+    for at the scales of one to :data:`TURN_SCALES` pieces (:func:`_turns_pieces`), a
+    piece per :data:`PIECE_TURN` degrees. The most: the same at a piece per
+    ``PIECE_TURN / DENSITY_RATIO`` degrees (:func:`equalise_pieces`). The turnings are
+    measured once for both.
 
     Returns
     -------
-    (C,) int64
+    pieces, most : (C,) int64
+    lengths : (C,) float64
     """
     lengths = np.array([arc_length(c) for c in curves])
     med = float(np.median(lengths)) if len(lengths) else 1.0
-    turn = _turns_pieces([np.asarray(c, dtype=np.float64) for c in curves], turn)
     # a curve exactly PIECE_LENGTH medians long (rounding noise aside) stays one piece
-    m = np.maximum(np.ceil(lengths / (PIECE_LENGTH * max(med, DIVISION_GUARD)) - PIECE_ROUNDING),
-                   turn)
-    m = np.maximum(m, 1).astype(np.int64)
-    return np.where(closed, np.maximum(m, 2), m)
+    by_length = np.ceil(lengths / (PIECE_LENGTH * max(med, DIVISION_GUARD)) - PIECE_ROUNDING)
+    turnings = _scale_turnings(curves)
+    out = []
+    for turn in (PIECE_TURN, PIECE_TURN / DENSITY_RATIO):
+        m = np.maximum(np.maximum(by_length, _turns_pieces(turnings, turn)), 1).astype(np.int64)
+        out.append(np.where(closed, np.maximum(m, 2), m))
+    return out[0], out[1], lengths
 
 
 def _strips(C: int, loops: list) -> np.ndarray:
@@ -230,15 +243,14 @@ def equalise_pieces(m: np.ndarray, loops: list, lengths: np.ndarray, jend: np.nd
     Parameters
     ----------
     m : (C,) int64
-        Pieces per curve (:func:`curve_pieces`).
+        Pieces per curve (:func:`piece_counts`).
     loops : list of list of (int, bool)
     lengths : (C,) float64
         Arc length of each curve.
     jend : (C, 2) int64
         Junction of each curve's start and end.
     most : (C,) int64
-        The most pieces a continuation may give each curve: :func:`curve_pieces` with
-        ``turn = PIECE_TURN / DENSITY_RATIO``.
+        The most pieces a continuation may give each curve (:func:`piece_counts`).
 
     Returns
     -------

@@ -120,16 +120,16 @@ def test_non_manifold_curve_is_shared_by_the_pieces():
 
 
 def test_adaptive_pieces_follow_quad_strips():
-    from curvenet.surfacing.pieces import curve_pieces
+    from curvenet.surfacing.pieces import piece_counts
     t = np.linspace(0, 1, 33)[:, None]
     curves = [t * [3, 0, 0], [3, 0, 0] + t * [0, 1, 0], [3, 1, 0] - t * [3, 0, 0],
               [0, 1, 0] - t * [0, 1, 0]]
     # lengths 3, 1, 3, 1: median 2, so no curve exceeds 2 x median -> one piece each
-    np.testing.assert_array_equal(curve_pieces(curves, np.zeros(4, bool)), [1, 1, 1, 1])
+    np.testing.assert_array_equal(piece_counts(curves, np.zeros(4, bool))[0], [1, 1, 1, 1])
     # a wavy bottom turns by more than 120 degrees in total -> more pieces; the
     # opposite curve follows so the loop stays one grid
     curves[0] = np.concatenate([3 * t, 0 * t, 0.1 * np.sin(6 * np.pi * t)], 1)
-    m = curve_pieces(curves, np.zeros(4, bool))
+    m = piece_counts(curves, np.zeros(4, bool))[0]
     assert m[0] >= 2 and m[1] == m[2] == m[3] == 1
     cm = build_control_mesh(curves, [[(i, True) for i in range(4)]], 4)
     assert [len(v) - 1 for v in cm.curve_vids] == [4 * m[0], 4, 4 * m[0], 4]
@@ -195,7 +195,7 @@ def test_stroke_wobble_does_not_count_as_winding():
     # of 1% of its length, three periods: the scale of the re-drawn torus's strokes),
     # which adds up when summed over fine segments (136 degrees at 32). It stays one
     # piece, like the clean arc; a half circle (180 degrees) gets two either way.
-    from curvenet.surfacing.pieces import curve_pieces
+    from curvenet.surfacing.pieces import piece_counts
     t = np.linspace(0, 1, 200)
 
     def arc(turn, wobble):
@@ -203,12 +203,12 @@ def test_stroke_wobble_does_not_count_as_winding():
         return np.c_[np.cos(t * turn), np.sin(t * turn), 0 * t] * r[:, None]
 
     arcs = [arc(np.pi / 2, 0), arc(np.pi / 2, 0.01), arc(np.pi, 0), arc(np.pi, 0.01)]
-    np.testing.assert_array_equal(curve_pieces(arcs, np.zeros(4, bool)), [1, 1, 2, 2])
+    np.testing.assert_array_equal(piece_counts(arcs, np.zeros(4, bool))[0], [1, 1, 2, 2])
     # detail finer than one piece still counts: a straight curve with 12 waves turns by
     # ~1500 degrees (8 segments alias it to a few hundred); it gets the pieces that bring
     # its turning at their own scale under 120 degrees per piece
     wavy = np.c_[t, 0.05 * np.sin(24 * np.pi * t), 0 * t]
-    m = curve_pieces([wavy] * 4, np.zeros(4, bool))[0]
+    m = piece_counts([wavy] * 4, np.zeros(4, bool))[0][0]
     fine = np.diff(wavy, axis=0)
     fine /= np.linalg.norm(fine, axis=1, keepdims=True)
     total = np.degrees(np.arccos(np.clip((fine[1:] * fine[:-1]).sum(1), -1, 1))).sum()
@@ -244,8 +244,8 @@ def test_bad_loops_rejected():
 def test_vectorised_turning_is_the_per_curve_loop_bit_for_bit():
     """Oracle: the one-curve :func:`_turning` and a loop over scales (issue 32)."""
     from curvenet.surfacing.pieces import (PIECE_ROUNDING, PIECE_TURN, TURN_SCALES,
-                                                TURN_SEGMENTS, _turning, _turnings,
-                                                _turns_pieces)
+                                                TURN_SEGMENTS, _scale_turnings, _turning,
+                                                _turnings, _turns_pieces)
     rng = np.random.default_rng(3)
     curves = [e.curve for e in shapes.torus().network.edges]
     curves += [np.cumsum(rng.normal(size=(int(rng.integers(2, 80)), 3)), 0) for _ in range(200)]
@@ -261,6 +261,6 @@ def test_vectorised_turning_is_the_per_curve_loop_bit_for_bit():
             if t > s * (1 + PIECE_ROUNDING):
                 need = max(need, int(np.ceil(t - PIECE_ROUNDING)))
         return need
-    got = _turns_pieces(curves)
+    got = _turns_pieces(_scale_turnings(curves), PIECE_TURN)
     assert np.array_equal(got, [pieces(c) for c in curves])
     assert got.max() > 1                        # the random walks do ask for pieces
