@@ -4,8 +4,10 @@ A CAD part's faces are mostly elementary surfaces, and a face's boundary curves 
 them: two coaxial circles and a straight seam lie on one cylinder, three quarter
 circles meeting at right angles on one sphere. :func:`fit_analytic` fits each kind,
 simplest first (plane, cylinder, cone, sphere, torus), to the boundary samples and
-keeps the first whose residual at *every* sample is within the tolerance; a free-form
-boundary fits none and stays a B-spline face. The classical route then puts the
+keeps the first whose residual at *every* sample is within the tolerance, among the
+kinds the samples over-determine (:data:`FREEDOMS`) and whose surface holds the arcs
+drawn through the curves' samples; a free-form boundary fits none and stays a
+B-spline face. The classical route then puts the
 patch's mesh on that surface (:func:`AnalyticSurface.project`) and the CAD export
 writes the surface itself, trimmed by the boundary curves, so both agree.
 
@@ -38,7 +40,7 @@ from curvenet.core.geometry import fit_plane
 from curvenet.core.tolerances import DIVISION_GUARD
 
 __all__ = ["AnalyticSurface", "fit_analytic", "fit_circle", "KINDS", "ANALYTIC_TOL",
-           "MAX_RADIUS"]
+           "MAX_RADIUS", "FREEDOMS"]
 
 #: Surface kinds, simplest first: the order :func:`fit_analytic` tries them in.
 KINDS = ("plane", "cylinder", "cone", "sphere", "torus")
@@ -52,6 +54,11 @@ MAX_RADIUS = 10.0
 CURVE_TOL = 1e-6
 #: Cosine above which two axis guesses count as the same direction.
 SAME_AXIS = 1.0 - 1e-9
+#: Parameters that fix a surface of each kind (a cylinder: its axis line 4 and its
+#: radius; a cone: apex 3, axis 2, semi-angle; a torus: centre 3, axis 2, both radii). A
+#: boundary is taken for a kind only when more distinct samples than these lie on it: six
+#: points lie on some cone, and eight or fewer on some torus, whatever they are.
+FREEDOMS = {"plane": 3, "cylinder": 5, "cone": 6, "sphere": 4, "torus": 7}
 
 
 @dataclass(frozen=True)
@@ -427,7 +434,10 @@ def fit_analytic(curves, *, tol: float, diagonal: float, kinds=KINDS, loops=None
     Returns
     -------
     AnalyticSurface or None
-        The first kind within ``tol`` (its ``residual`` the largest distance), or None.
+        The first kind within ``tol`` (its ``residual`` the largest distance) that the
+        samples over-determine (more distinct ones than its :data:`FREEDOMS`) and that
+        holds the arcs the curves are written as between their samples
+        (:func:`_arcs_on`), or None.
 
     Examples
     --------
@@ -442,9 +452,12 @@ def fit_analytic(curves, *, tol: float, diagonal: float, kinds=KINDS, loops=None
     p = np.concatenate(curves)
     if len(p) < 3:
         return None
+    distinct = _distinct(p, tol)
     c, n, _ = fit_plane(p)
     axes, arcs = None, None
     for kind in kinds:
+        if distinct <= FREEDOMS[kind]:
+            continue
         if kind == "plane":
             res = float(np.abs((p - c) @ n).max())
             if res <= tol:
@@ -460,9 +473,48 @@ def fit_analytic(curves, *, tol: float, diagonal: float, kinds=KINDS, loops=None
             s = _rebased(_surface(kind, best[0], best[1]), p)
             if (max(abs(s.radius), s.minor if kind == "torus" else 0.0) <= MAX_RADIUS * diagonal
                     and not _through_singularity(s, p, tol, loops)
-                    and (kind != "cone" or _drawn_cone(s, curves, tol))):
+                    and (kind != "cone" or _drawn_cone(s, curves, tol))
+                    and _arcs_on(s, curves, tol)):
                 return s
     return None
+
+
+def _arcs_on(s: AnalyticSurface, curves, tol: float) -> bool:
+    """Whether the circular arcs through the curves that lie on circles (as the CAD
+    output writes them, :func:`fit_circle`) stay within ``tol`` of ``s`` midway between
+    their samples. Any three points lie on a circle: a curve of three samples is written
+    as the arc through them, which leaves the surface unless the curve is a circle of it
+    (a section of a cylinder by a slanted plane is an ellipse, not the arc through three
+    of its points)."""
+    for c in curves:
+        if len(c) < 3 or _straight(c) is not None:
+            continue
+        got = fit_circle(c)
+        if got is None:
+            continue
+        centre, normal, r = got
+        d = c - centre
+        d = d - np.outer(d @ normal, normal)
+        mid = d[:-1] + d[1:]
+        half = np.linalg.norm(mid, axis=1) <= DIVISION_GUARD * r   # samples half a turn apart
+        mid[half] = np.cross(normal, d[:-1][half])
+        mid = centre + r * mid / np.linalg.norm(mid, axis=1, keepdims=True)
+        if np.abs(s.distance(mid)).max() > tol:
+            return False
+    return True
+
+
+def _distinct(p, tol: float) -> int:
+    """Samples ``p`` (n, 3) counted once per cluster within ``tol`` (a junction's
+    sample is the end of every curve through it)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    from scipy.spatial import cKDTree
+    pairs = cKDTree(p).query_pairs(max(tol, 0.0), output_type="ndarray")
+    if not len(pairs):
+        return len(p)
+    g = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(p), len(p)))
+    return int(connected_components(g, directed=False)[0])
 
 
 def _apex(s: AnalyticSurface):

@@ -79,6 +79,28 @@ def test_a_slightly_bent_curve_is_refused_at_the_tolerance():
     assert fit_analytic(curves, tol=2e-4, diagonal=2.0, kinds=("cylinder",)).kind == "cylinder"
 
 
+def test_a_loop_of_too_few_samples_is_no_curved_surface():
+    # three curves of three samples (mingzou/Boat, flowrep/espresso): six points lie on
+    # some cone and eight on some torus whatever they are, and an arc through three says
+    # nothing of the curve between them; the same loops drawn with five samples a curve
+    # are free-form too
+    rng = np.random.default_rng(0)
+    for samples in (3, 5):
+        for _ in range(20):
+            c = rng.normal(size=(3, 3))
+            s = np.linspace(0, 1, samples)[:, None]
+            curves = [c[i] + s * (c[(i + 1) % 3] - c[i])
+                      + 0.15 * rng.normal(size=(samples, 3)) * (s * (1 - s) > 0)
+                      for i in range(3)]
+            d = float(np.linalg.norm(np.ptp(np.concatenate(curves), axis=0)))
+            assert fit_analytic(curves, tol=1e-5 * d, diagonal=d) is None
+    # a planar loop of three-sample curves is still its plane
+    plane = [np.c_[cu, np.zeros(3)] for cu in ([[0, 0], [1, 0.2], [2, 0]],
+                                               [[2, 0], [1.2, 1], [1, 2]],
+                                               [[1, 2], [0.3, 1], [0, 0]])]
+    assert fit_analytic(plane, tol=1e-6, diagonal=3.0).kind == "plane"
+
+
 def test_huge_radii_are_refused():
     # a shallow arc of radius 1000 on a face of size 1 is taken for no cylinder
     a = np.linspace(-5e-4, 5e-4, 17)
