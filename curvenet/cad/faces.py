@@ -231,12 +231,34 @@ def analytic_face(surface, boundary, edges, *, tolerance: float, name: str, curv
     Returns
     -------
     TopoDS_Face
+        Bounding a positive area of the surface; reversed (its normal against the
+        surface's) when the loops run clockwise about the surface's normal, as half of
+        the patches do whose surface's orientation the fit chose.
 
     Raises
     ------
     CadInputError
         A loop crosses itself on the surface.
     """
+    face = _analytic_face(surface, boundary, edges, tolerance, name, curves)
+    if _area(face) >= 0.0:
+        return face
+    from OCP.TopoDS import TopoDS
+    back = [[(e, not fwd) for e, fwd in reversed(lp)] for lp in boundary]
+    return TopoDS.Face(_analytic_face(surface, back, edges, tolerance, name, curves).Reversed())
+
+
+def _area(face) -> float:
+    """Signed area of a face (negative: its wires bound the outside of their region)."""
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+    g = GProp_GProps()
+    BRepGProp.SurfaceProperties_s(face, g)
+    return float(g.Mass())
+
+
+def _analytic_face(surface, boundary, edges, tolerance, name, curves):
+    """:func:`analytic_face` with the loops as given."""
     from OCP.BRepTools import BRepTools
     from OCP.ShapeAnalysis import ShapeAnalysis_Wire
     wires = [_wire(lp, edges) for lp in boundary]
