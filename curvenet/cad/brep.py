@@ -22,15 +22,26 @@ from .faces import CadInputError, TrimCheckError, analytic_face, check_plane_loo
 from .occ import free_edge_count, heal, is_valid, occ_faces
 
 __all__ = ["CadModel", "brep_shape", "build_solids", "solid_volumes", "face_kinds",
-           "manifold_groups", "SEW_TOL", "CAD_KINDS", "nurbs_convertible"]
+           "manifold_groups", "SEW_TOL", "SEW_MARGINS", "CAD_KINDS", "nurbs_convertible"]
 
 #: Analytic kinds written as trimmed elementary faces (spheres and tori with their
 #: curves on the surface made from the samples, :mod:`curvenet.cad.pcurves`).
 CAD_KINDS = ("plane", "cylinder", "cone", "sphere", "torus")
-#: Sewing tolerance as a fraction of the diagonal, never below twice the largest gap
-#: between the B-spline pieces' borders and the curves (when the shape has pieces) or
-#: twice the largest residual of the trimmed faces' surfaces.
+#: Sewing tolerance as a fraction of the diagonal, never below a margin of
+#: :data:`SEW_MARGINS` times the largest gap between the B-spline pieces' borders and the
+#: curves (when the shape has pieces) and the largest residual of the trimmed faces'
+#: surfaces.
 SEW_TOL = 1e-6
+#: Margins tried in turn for STEP while the sewn shape is not valid: a face narrower than
+#: the tolerance (a sliver between two strokes drawn almost on top of each other) has
+#: its sides sewn together; ``ShapeFix_Shape`` makes the shape valid with degenerate
+#: edges inside faces, whose curves on the surface STEP readers rebuild from their
+#: neighbours, wrongly there (the file read back is not valid). The first valid shape
+#: is kept; when none is, the first one, healed. 3DM keeps the first margin, healed when
+#: it must be: its writer makes such edges singular trims or leaves them out of their
+#: loop (:mod:`curvenet.cad.trims`), and openNURBS refused a loop of the NURBS
+#: conversion of a shape sewn at a smaller margin (flowrep espresso).
+SEW_MARGINS = (2.0, 1.5, 1.0)
 #: OpenCascade's surface types by the names the report uses.
 _KIND_NAMES = {"GeomAbs_Plane": "plane", "GeomAbs_Cylinder": "cylinder",
                "GeomAbs_Cone": "cone", "GeomAbs_Sphere": "sphere", "GeomAbs_Torus": "torus",
@@ -210,7 +221,7 @@ def brep_shape(model: CadModel, *, nurbs: bool = False):
         The shape will be converted to NURBS (3DM): when OpenCascade's conversion
         refuses the sewn shape (a trimmed torus whose periodic range came out a rounding
         past its period raises ``Standard_DomainError``), spheres and tori are written
-        as their B-spline pieces.
+        as their B-spline pieces; the sewing keeps the first of :data:`SEW_MARGINS`.
 
     Returns
     -------
@@ -219,7 +230,8 @@ def brep_shape(model: CadModel, *, nurbs: bool = False):
         ``faces``: per face ``patch``, ``kind`` (``"plane"`` ... ``"bspline"``) and
         ``residual`` (analytic faces: largest distance of the boundary samples to the
         surface, fraction of the diagonal); ``edges``: counts per curve kind;
-        ``sew_tolerance`` (model units), ``sewing_free_edges``, ``volumes``,
+        ``sew_tolerance`` (model units: for STEP the first of :data:`SEW_MARGINS` that
+        gave a valid shape), ``sewing_free_edges``, ``volumes``,
         ``manifold_pieces``, ``shape_fixed`` (healed because the sewn shape was not
         valid), ``pieced_for_validity`` (sphere and torus patches written as their
         B-spline pieces because the shape with them trimmed was not valid; absent when
@@ -232,18 +244,19 @@ def brep_shape(model: CadModel, *, nurbs: bool = False):
         A face whose boundary crosses itself (named by its patch).
     """
     pieces = occ_faces(model.pieces)
-    shape, rep = _brep(model, CAD_KINDS, pieces)
+    margins = SEW_MARGINS[:1] if nurbs else SEW_MARGINS
+    shape, rep = _brep(model, CAD_KINDS, pieces, margins)
     pieced = {int(k) for k in model.piece_patch}
     curved = [k for k, s in enumerate(model.surfaces)
               if s is not None and s.kind in _DOUBLY_CURVED and k in pieced]
     plain = tuple(k for k in CAD_KINDS if k not in _DOUBLY_CURVED)
     if curved and not is_valid(shape):
-        shape2, rep2 = _brep(model, plain, pieces)
+        shape2, rep2 = _brep(model, plain, pieces, margins)
         if is_valid(shape2):
             shape, rep = shape2, rep2
             rep["pieced_for_validity"] = curved
     if nurbs and curved and "pieced_for_validity" not in rep and not nurbs_convertible(shape):
-        shape, rep = _brep(model, plain, pieces)
+        shape, rep = _brep(model, plain, pieces, margins)
         rep["pieced_for_nurbs"] = curved
     rep["volumes"] = solid_volumes(shape)
     return shape, rep
@@ -264,18 +277,19 @@ def nurbs_convertible(shape) -> bool:
     return True
 
 
-def _brep(model: CadModel, kinds, pieces: list):
+def _brep(model: CadModel, kinds, pieces: list, margins):
     """:func:`brep_shape` with the patches of ``kinds`` as trimmed faces and the others
     as their pieces (``pieces``: the faces of ``model.pieces``; patches with none are
-    left out)."""
+    left out), sewn at ``margins`` in turn (:data:`SEW_MARGINS`)."""
     diag = model.diagonal if model.diagonal > 0 else 1.0
     analytic = [k for k, s in enumerate(model.surfaces) if s is not None and s.kind in kinds]
     # the pieces' borders lie up to the gap from the curves; trimmed faces' edges are the
     # curves themselves, on their surfaces within the residual
     trimmed = set(analytic)
     with_pieces = any(int(k) not in trimmed for k in model.piece_patch)
-    tol = max([SEW_TOL * diag, 2.0 * model.gap if with_pieces else 0.0]
-              + [2.0 * model.surfaces[k].residual for k in analytic])
+    need = max([model.gap if with_pieces else 0.0]
+               + [model.surfaces[k].residual for k in analytic])
+    tols = list(dict.fromkeys(max(SEW_TOL * diag, m * need) for m in margins))
     used = {e for k in analytic for lp in model.boundaries[k] for e, _ in lp}
     edges = curve_edges(model.curves, model.ends, model.positions, used, diagonal=diag)
     faces, info, of_patch = [], [], {}
@@ -284,7 +298,7 @@ def _brep(model: CadModel, kinds, pieces: list):
         if s.kind == "plane":
             check_plane_loops(s, model.boundaries[k], model.curves, model.name(k))
         try:
-            face = analytic_face(s, model.boundaries[k], edges, tolerance=tol,
+            face = analytic_face(s, model.boundaries[k], edges, tolerance=tols[0],
                                  name=model.name(k), curves=model.curves)
         except CadInputError as err:
             raise TrimCheckError(str(err), k) from None
@@ -300,9 +314,15 @@ def _brep(model: CadModel, kinds, pieces: list):
     groups = [np.array([f for k in g for f in of_patch.get(int(k), [])], np.int64)
               for g in manifold_groups(model.boundaries)]
     groups = [g for g in groups if len(g)]
-    shape, rep = build_solids(faces, groups, tol)
+    tries = []
+    for t in tols:
+        tries.append((t, *build_solids(faces, groups, t)))
+        if is_valid(tries[-1][1]):
+            break
+    tol, shape, rep = tries[-1]
     fixed = not is_valid(shape)
     if fixed:
+        tol, shape, rep = tries[0]
         shape = heal(shape)
     kinds: dict = {}
     for _, kind in edges.values():
