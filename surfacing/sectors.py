@@ -23,6 +23,7 @@ from curvenet.core.geometry import fit_plane
 
 from .analytic import ANALYTIC_TOL, AnalyticSurface, fit_analytic
 from .api import DEFAULT_EDGE_LENGTH, DEFAULT_MAX_FACES, PatchMeshResult, surface_loops
+from .bands import mesh_bands
 from .flat import FLAT_TOL, flat_planes, flatten_planar, loop_points, mesh_flat
 
 __all__ = ["split_holed", "split_boundaries", "surface_boundaries", "analytic_faces",
@@ -353,7 +354,9 @@ def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: f
     analytic_tol : float or None
         Patches whose boundary lies on a plane, cylinder, cone, sphere or torus within
         this fraction of the diagonal (:func:`analytic_faces`) get their mesh vertices
-        projected onto it; None: no analytic faces (every face as the fit leaves it).
+        projected onto it, those of revolution bounded by parallels and a seam meshed as
+        rings about their axis (:func:`surfacing.bands.mesh_bands`); None: no analytic
+        faces (every face as the fit leaves it).
     **options
         Passed to :func:`surfacing.surface_loops` (``crease_curves``, ``resolution``, ...).
 
@@ -362,8 +365,9 @@ def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: f
     PatchMeshResult
         ``face_patch`` indexes ``boundaries``; ``report`` adds ``n_sectors``
         (loops surfaced), ``cuts``, ``flat_patches``, ``flat_meshed`` (those meshed
-        in-plane), ``unsplit_holes``, ``loop_patch`` (the patch of each loop of the
-        control net, sectors included) and ``analytic``: per patch the
+        in-plane), ``bands`` (the patches meshed as rings), ``unsplit_holes``,
+        ``loop_patch`` (the patch of each loop of the control net, sectors included)
+        and ``analytic``: per patch the
         :meth:`~surfacing.analytic.AnalyticSurface.to_dict` of its surface (with
         ``residual`` in model units) or None; ``curves`` (when asked for) holds the
         input curves only.
@@ -375,20 +379,28 @@ def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: f
     res = surface_loops(all_curves, loops, **options)
     face_patch = owner[res.face_patch]
     V = flatten_planar(res.vertices, res.faces, face_patch, flat, normals, offsets)
-    auto = options.get("subdiv") is None
-    target = options.get("edge_length", DEFAULT_EDGE_LENGTH) * res.control_net.diagonal
-    V, F, face_patch, meshed = mesh_flat(
-        V, res.faces, face_patch, res.curve_vertices, curves, boundaries, flat, normals,
-        offsets, edge_length=target if auto else None,
-        max_faces=max(DEFAULT_MAX_FACES, len(res.faces)) if auto else None)
     surfaces = [None] * len(boundaries)
     if analytic_tol is not None:
         surfaces = analytic_faces(curves, boundaries, tol=analytic_tol, flat=flat,
                                   normals=normals, offsets=offsets)
+        diag = float(np.linalg.norm(np.ptp(np.concatenate(curves), axis=0)))
+        V, F, face_patch, banded = mesh_bands(V, res.faces, face_patch, res.curve_vertices,
+                                              curves, boundaries, surfaces,
+                                              analytic_tol * diag)
+    else:
+        F, banded = res.faces, np.zeros(len(boundaries), bool)
+    auto = options.get("subdiv") is None
+    target = options.get("edge_length", DEFAULT_EDGE_LENGTH) * res.control_net.diagonal
+    V, F, face_patch, meshed = mesh_flat(
+        V, F, face_patch, res.curve_vertices, curves, boundaries, flat, normals,
+        offsets, edge_length=target if auto else None,
+        max_faces=max(DEFAULT_MAX_FACES, len(F)) if auto else None)
+    if analytic_tol is not None:
         V = _on_surfaces(V, F, face_patch, surfaces, _heights(curves, boundaries, surfaces))
     report = dict(res.report, n_patches=len(boundaries), n_sectors=len(loops),
                   cuts=len(all_curves) - n, flat_patches=int(flat.sum()),
-                  flat_meshed=int(meshed.sum()), n_faces=len(F), unsplit_holes=unsplit,
+                  flat_meshed=int(meshed.sum()), bands=np.flatnonzero(banded).tolist(),
+                  n_faces=len(F), unsplit_holes=unsplit,
                   loop_patch=owner.tolist(),
                   analytic=[None if s is None else s.to_dict() for s in surfaces])
     new_curves = None if res.curves is None else res.curves[:n]
