@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from .analytic import AnalyticSurface, fit_circle
+from .flat import replace_faces
 
 __all__ = ["band_frame", "mesh_bands"]
 
@@ -245,8 +246,7 @@ def mesh_bands(vertices, faces, face_patch, chains, curves, boundaries, surfaces
     meshed = np.zeros(len(boundaries), bool)
     if chains is None:
         return V, F, FP, meshed
-    keep = np.ones(len(F), bool)
-    new_v, new_f, new_p = [], [], []
+    new_v, new_f = [], []
     for k, (b, s) in enumerate(zip(boundaries, surfaces)):
         got = None if s is None else band_frame(s, b, curves, tol)
         old = FP == k
@@ -259,14 +259,10 @@ def mesh_bands(vertices, faces, face_patch, chains, curves, boundaries, surfaces
         sid = np.asarray(chains[seam], np.int64)
         _on_seam(V, sid, np.asarray(curves[seam], np.float64), [r is None for r in rims])
         pts, tri = _band(np.concatenate([V, *new_v]), (origin, axis), sid, rims)
-        if _same_way(tri, F[~old & keep], F[old], rims) is False:
+        around = np.concatenate([F[~old & ~meshed[FP]], *new_f])
+        if _same_way(tri, around, F[old], rims) is False:
             tri = tri[:, ::-1]
-        keep &= ~old
         meshed[k] = True
         new_v.append(pts)
         new_f.append(tri)
-        new_p.append(np.full(len(tri), k))
-    V = np.concatenate([V, *new_v])
-    F = np.concatenate([F[keep], *new_f]).astype(np.int64)
-    FP = np.concatenate([FP[keep], *new_p]).astype(np.int64)
-    return V, F, FP, meshed
+    return (*replace_faces(V, F, FP, np.flatnonzero(meshed), new_v, new_f), meshed)

@@ -21,7 +21,8 @@ import numpy as np
 
 from curvenet.core.geometry import fit_plane
 
-__all__ = ["FLAT_TOL", "flat_planes", "flatten_planar", "mesh_flat", "loop_points"]
+__all__ = ["FLAT_TOL", "flat_planes", "flatten_planar", "mesh_flat", "loop_points",
+           "replace_faces"]
 
 #: A patch is flat when its boundary points lie this close to a plane (fraction of the diagonal).
 FLAT_TOL = 1e-6
@@ -222,8 +223,7 @@ def mesh_flat(vertices, faces, face_patch, chains, curves, boundaries, flat, nor
     budget = None if max_faces is None else max_faces - int((~flat[FP]).sum())
     cdts = _cdts(frames, _spacings(frames, edge_length, budget), budget)
     meshed = np.zeros(len(boundaries), bool)
-    keep = np.ones(len(F), bool)
-    new_v, new_f, new_p = [], [], []
+    new_v, new_f = [], []
     n_next = len(V)
     for k, fr, got in zip(todo, frames, cdts):
         if got is None:
@@ -236,18 +236,29 @@ def mesh_flat(vertices, faces, face_patch, chains, curves, boundaries, flat, nor
         facing = _orient(V, F[old]) if old.any() else _newell(V[fr["ids"][fr["rings"][0]]])
         if facing @ normals[k] < 0:
             tri = tri[:, ::-1]
-        keep &= ~old
         meshed[k] = True
         new_v.append(inner)
         new_f.append(tri)
-        new_p.append(np.full(len(tri), k))
-    V = np.concatenate([V, *new_v])
-    F = np.concatenate([F[keep], *new_f]).astype(np.int64)
-    FP = np.concatenate([FP[keep], *new_p]).astype(np.int64)
+    V, F, FP = replace_faces(V, F, FP, np.flatnonzero(meshed), new_v, new_f)
     used = np.zeros(len(V), bool)
     used[F.ravel()] = True
     remap = np.cumsum(used) - 1
     return V[used], remap[F], FP, meshed
+
+
+def replace_faces(V, F, FP, patches, vertices, triangles):
+    """A mesh with the faces of ``patches`` replaced.
+
+    ``V`` (n, 3) float64, ``F`` (f, 3) int64, ``FP`` (f,) int64 the patch of each face;
+    ``patches`` (p,) int; per patch its new ``vertices`` (k_i, 3), appended to ``V`` in
+    order, and its ``triangles`` (t_i, 3) indexing the grown vertex array. Returns the
+    new ``(V, F, FP)``, the replaced faces' vertices left in place.
+    """
+    keep = ~np.isin(FP, patches)
+    return (np.concatenate([V, *vertices]),
+            np.concatenate([F[keep], *triangles]).astype(np.int64),
+            np.concatenate([FP[keep], *(np.full(len(t), k) for k, t in zip(patches, triangles))]
+                           ).astype(np.int64))
 
 
 def _cdts(frames, spacing, budget, tries: int = 3):
