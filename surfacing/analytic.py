@@ -380,18 +380,22 @@ def _refined(kind, p, guesses, tol):
             return
 
 
-def _axis_guesses(p, curves) -> list:
-    """Unit axis guesses: straight curves' directions, arcs' normals, principal axes."""
-    out, lines, arcs = [], [], []
+def _shapes(curves) -> list:
+    """Per curve ``(direction, None)`` when it is straight, ``(None, (centre, normal,
+    radius))`` when it lies on a circle (:func:`fit_circle`), else ``(None, None)``."""
+    out = []
     for c in curves:
         u = _straight(c)
-        if u is not None:
-            lines.append(u)
-            continue
-        got = fit_circle(c)
-        if got is not None:
-            arcs.append(got)
-    out += lines + [n for _, n, _ in arcs]
+        out.append((u, None if u is not None else fit_circle(c)))
+    return out
+
+
+def _axis_guesses(p, shapes) -> list:
+    """Unit axis guesses: straight curves' directions, arcs' normals (``shapes``,
+    :func:`_shapes`), principal axes."""
+    out = [u for u, _ in shapes if u is not None]
+    arcs = [a for _, a in shapes if a is not None]
+    out += [n for _, n, _ in arcs]
     out += list(np.linalg.svd(p - p.mean(axis=0), full_matrices=False)[2])
     uniq = []
     for a in out:
@@ -454,7 +458,7 @@ def fit_analytic(curves, *, tol: float, diagonal: float, kinds=KINDS, loops=None
         return None
     distinct = _distinct(p, tol)
     c, n, _ = fit_plane(p)
-    axes, arcs = None, None
+    axes, arcs, shapes = None, None, None
     for kind in kinds:
         if distinct <= FREEDOMS[kind]:
             continue
@@ -464,7 +468,8 @@ def fit_analytic(curves, *, tol: float, diagonal: float, kinds=KINDS, loops=None
                 return AnalyticSurface("plane", c, _unit(n), _normal_to(n), 0.0, 0.0, res)
             continue
         if axes is None:
-            axes, arcs = _axis_guesses(p, curves)
+            shapes = _shapes(curves)
+            axes, arcs = _axis_guesses(p, shapes)
         best = None
         for x, res in _refined(kind, p, _candidates(kind, p, axes, arcs), tol):
             if best is None or res < best[1]:
@@ -473,26 +478,23 @@ def fit_analytic(curves, *, tol: float, diagonal: float, kinds=KINDS, loops=None
             s = _rebased(_surface(kind, best[0], best[1]), p)
             if (max(abs(s.radius), s.minor if kind == "torus" else 0.0) <= MAX_RADIUS * diagonal
                     and not _through_singularity(s, p, tol, loops)
-                    and (kind != "cone" or _drawn_cone(s, curves, tol))
-                    and _arcs_on(s, curves, tol)):
+                    and (kind != "cone" or _drawn_cone(s, curves, shapes, tol))
+                    and _arcs_on(s, curves, shapes, tol)):
                 return s
     return None
 
 
-def _arcs_on(s: AnalyticSurface, curves, tol: float) -> bool:
-    """Whether the circular arcs through the curves that lie on circles (as the CAD
-    output writes them, :func:`fit_circle`) stay within ``tol`` of ``s`` midway between
-    their samples. Any three points lie on a circle: a curve of three samples is written
+def _arcs_on(s: AnalyticSurface, curves, shapes, tol: float) -> bool:
+    """Whether the circular arcs through the curves that lie on circles (``shapes``, as
+    the CAD output writes them, :func:`fit_circle`) stay within ``tol`` of ``s`` midway
+    between their samples. Any three points lie on a circle: a curve of three samples is written
     as the arc through them, which leaves the surface unless the curve is a circle of it
     (a section of a cylinder by a slanted plane is an ellipse, not the arc through three
     of its points)."""
-    for c in curves:
-        if len(c) < 3 or _straight(c) is not None:
+    for c, (_, arc) in zip(curves, shapes):
+        if arc is None:
             continue
-        got = fit_circle(c)
-        if got is None:
-            continue
-        centre, normal, r = got
+        centre, normal, r = arc
         d = c - centre
         d = d - np.outer(d @ normal, normal)
         mid = d[:-1] + d[1:]
@@ -524,7 +526,7 @@ def _apex(s: AnalyticSurface):
     return s.origin - (s.radius / np.tan(s.minor)) * s.axis
 
 
-def _drawn_cone(s: AnalyticSurface, curves, tol: float) -> bool:
+def _drawn_cone(s: AnalyticSurface, curves, shapes, tol: float) -> bool:
     """Whether a cone's boundary holds one of the curves a cone face is drawn with: a
     circle about its axis (a chamfer's or countersink's rim), a ruling (a line through
     its apex) or the apex itself (a pin's point). A loop of free-form curves that happens
@@ -534,18 +536,16 @@ def _drawn_cone(s: AnalyticSurface, curves, tol: float) -> bool:
     apex = _apex(s)
     if apex is None:
         return False
-    for c in curves:
+    for c, (u, arc) in zip(curves, shapes):
         if np.linalg.norm(c[[0, -1]] - apex, axis=1).min() <= tol:
             return True
-        u = _straight(c)
         if u is not None:
             off = (apex - c[0]) - ((apex - c[0]) @ u) * u
             if np.linalg.norm(off) <= tol:
                 return True
             continue
-        got = fit_circle(c)
-        if got is not None:
-            centre, normal, _ = got
+        if arc is not None:
+            centre, normal, _ = arc
             d = centre - apex
             on_axis = np.linalg.norm(d - (d @ s.axis) * s.axis) <= tol
             if abs(normal @ s.axis) > SAME_AXIS and on_axis:

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .analytic import AnalyticSurface, fit_circle
+from .analytic import AnalyticSurface, _in_plane, fit_circle
 from .flat import replace_faces
 
 __all__ = ["band_frame", "mesh_bands"]
@@ -82,14 +82,8 @@ def band_frame(surface: AnalyticSurface, boundary, curves, tol: float):
 def _cylindrical(p, origin, axis):
     """Height along the axis, distance from it and angle about it (any fixed frame) of
     points ``p`` (n, 3): three (n,) float64."""
-    d = np.asarray(p, np.float64) - origin
-    z = d @ axis
-    e1 = np.eye(3)[int(np.argmin(np.abs(axis)))]
-    e1 = e1 - (e1 @ axis) * axis
-    e1 /= np.linalg.norm(e1)
-    e2 = np.cross(axis, e1)
-    r = d - np.outer(z, axis)
-    return z, np.linalg.norm(r, axis=1), np.arctan2(r @ e2, r @ e1)
+    x, y, z, _, _ = _in_plane(np.asarray(p, np.float64), axis, origin)
+    return z, np.hypot(x, y), np.arctan2(y, x)
 
 
 def _zip(a, alpha, b, beta):
@@ -121,17 +115,18 @@ def _band(V, frame, seam_ids, rims):
     origin, axis = frame
     _, rho_s, ang_s = _cylindrical(V[seam_ids], origin, axis)
     last = len(seam_ids) - 1
-    ends = {}
+    ends, spacings = {}, []
     for k, ids in ((0, rims[0]), (last, rims[-1])):
         if ids is None:
             continue
         ids = np.unique(np.r_[ids, seam_ids[k]])
-        a = np.mod(_cylindrical(V[ids], origin, axis)[2] - ang_s[k], 2 * np.pi)
+        _, rho, a = _cylindrical(V[ids], origin, axis)
+        a = np.mod(a - ang_s[k], 2 * np.pi)
         a[ids == seam_ids[k]] = 0.0
         o = np.argsort(a, kind="stable")
         ends[k] = (ids[o], a[o])
-    spacing = np.mean([2 * np.pi * _cylindrical(V[r], origin, axis)[1].mean() / len(r)
-                       for r, _ in ends.values()])
+        spacings.append(2 * np.pi * rho.mean() / len(ids))
+    spacing = np.mean(spacings)
     rings, new, n_next = [], [], len(V)
     for k, sid in enumerate(seam_ids):
         if k in ends:

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .faces import CadInputError, TrimCheckError, analytic_face, check_plane_loops, curve_edges
-from .occ import free_edge_count, heal, is_valid, occ_faces
+from .occ import free_edge_count, heal, is_valid, occ_faces, volume
 
 __all__ = ["CadModel", "brep_shape", "build_solids", "solid_volumes", "face_kinds",
            "manifold_groups", "SEW_TOL", "SEW_MARGINS", "CAD_KINDS", "nurbs_convertible"]
@@ -61,14 +61,6 @@ def face_kinds(shape) -> list:
         out.append(_KIND_NAMES.get(t.name, "other"))
         exp.Next()
     return out
-
-
-def _volume(shape) -> float:
-    from OCP.BRepGProp import BRepGProp
-    from OCP.GProp import GProp_GProps
-    g = GProp_GProps()
-    BRepGProp.VolumeProperties_s(shape, g)
-    return float(g.Mass())
 
 
 def build_solids(faces, groups, tolerance: float):
@@ -127,7 +119,7 @@ def solid_volumes(shape) -> list:
     from OCP.TopExp import TopExp_Explorer
     out, exp = [], TopExp_Explorer(shape, TopAbs_SOLID)
     while exp.More():
-        out.append(_volume(exp.Current()))
+        out.append(volume(exp.Current()))
         exp.Next()
     return out
 

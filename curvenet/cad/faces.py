@@ -24,6 +24,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..core.errors import CurvenetError
+from .occ import area
 
 __all__ = ["CadInputError", "TrimCheckError", "curve_edges", "analytic_face",
            "check_plane_loops", "EDGE_TOL", "LINE_TOL"]
@@ -241,20 +242,11 @@ def analytic_face(surface, boundary, edges, *, tolerance: float, name: str, curv
         A loop crosses itself on the surface.
     """
     face = _analytic_face(surface, boundary, edges, tolerance, name, curves)
-    if _area(face) >= 0.0:
+    if area(face) >= 0.0:
         return face
     from OCP.TopoDS import TopoDS
     back = [[(e, not fwd) for e, fwd in reversed(lp)] for lp in boundary]
     return TopoDS.Face(_analytic_face(surface, back, edges, tolerance, name, curves).Reversed())
-
-
-def _area(face) -> float:
-    """Signed area of a face (negative: its wires bound the outside of their region)."""
-    from OCP.BRepGProp import BRepGProp
-    from OCP.GProp import GProp_GProps
-    g = GProp_GProps()
-    BRepGProp.SurfaceProperties_s(face, g)
-    return float(g.Mass())
 
 
 def _analytic_face(surface, boundary, edges, tolerance, name, curves):

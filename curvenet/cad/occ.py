@@ -12,7 +12,7 @@ import numpy as np
 from ..core.errors import MissingDependencyError
 
 __all__ = ["require_cad", "quiet_occ", "occ_faces", "count", "free_edge_count", "is_valid",
-           "heal", "shape_report"]
+           "heal", "shape_report", "area", "volume"]
 
 
 def require_cad(fmt: str):
@@ -87,6 +87,25 @@ def is_valid(shape) -> bool:
     """``BRepCheck_Analyzer``'s verdict."""
     from OCP.BRepCheck import BRepCheck_Analyzer
     return bool(BRepCheck_Analyzer(shape).IsValid())
+
+
+def area(shape) -> float:
+    """Signed area of a shape's faces (``BRepGProp``; a face whose wires bound the
+    outside of their region counts negative)."""
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+    g = GProp_GProps()
+    BRepGProp.SurfaceProperties_s(shape, g)
+    return float(g.Mass())
+
+
+def volume(shape) -> float:
+    """Signed volume a shape's faces enclose (``BRepGProp``; positive: faces outward)."""
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+    g = GProp_GProps()
+    BRepGProp.VolumeProperties_s(shape, g)
+    return float(g.Mass())
 
 
 def heal(shape):
