@@ -40,7 +40,7 @@ from curvenet.core.geometry import fit_plane
 from curvenet.core.tolerances import DIVISION_GUARD
 
 __all__ = ["AnalyticSurface", "fit_analytic", "fit_circle", "KINDS", "ANALYTIC_TOL",
-           "MAX_RADIUS", "FREEDOMS"]
+           "MAX_RADIUS", "FREEDOMS", "in_axis_frame"]
 
 #: Surface kinds, simplest first: the order :func:`fit_analytic` tries them in.
 KINDS = ("plane", "cylinder", "cone", "sphere", "torus")
@@ -198,8 +198,9 @@ def _from_angles(theta, phi) -> np.ndarray:
     return np.array([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)])
 
 
-def _in_plane(points, axis, origin):
-    """Coordinates ``(x, y, z)`` of points in a frame with ``z`` along ``axis``."""
+def in_axis_frame(points, axis, origin):
+    """Coordinates ``x, y, z`` ((n,) float64 each) of points (n, 3) in a frame with ``z``
+    along the unit ``axis`` from ``origin``, and the frame's ``e1, e2`` ((3,) each)."""
     e1 = _normal_to(axis)
     e2 = np.cross(axis, e1)
     d = np.asarray(points) - origin
@@ -228,7 +229,7 @@ def fit_circle(points, *, tol: float = CURVE_TOL):
     c, n, _ = fit_plane(p)
     if ext <= 0 or np.abs((p - c) @ n).max() > tol * ext:
         return None
-    x, y, _, e1, e2 = _in_plane(p, n, c)
+    x, y, _, e1, e2 = in_axis_frame(p, n, c)
     A = np.c_[2 * x, 2 * y, np.ones_like(x)]
     sol, *_ = np.linalg.lstsq(A, x * x + y * y, rcond=None)
     r2 = sol[2] + sol[0] ** 2 + sol[1] ** 2
@@ -264,7 +265,7 @@ def _kasa(x, y):
 
 def _guess_cylinder(p, axis):
     o = p.mean(axis=0)
-    x, y, _, e1, e2 = _in_plane(p, axis, o)
+    x, y, _, e1, e2 = in_axis_frame(p, axis, o)
     got = _kasa(x, y)
     if got is None:
         return None
@@ -275,7 +276,7 @@ def _guess_cylinder(p, axis):
 def _guess_cone(p, axis):
     """``x^2 + y^2 = 2 cx x + 2 cy y - e + 2 m z + q z^2`` with ``rho = R + k z``."""
     o = p.mean(axis=0)
-    x, y, z, e1, e2 = _in_plane(p, axis, o)
+    x, y, z, e1, e2 = in_axis_frame(p, axis, o)
     A = np.c_[2 * x, 2 * y, -np.ones_like(x), 2 * z, z * z]
     sol, *_ = np.linalg.lstsq(A, x * x + y * y, rcond=None)
     cx, cy, e, m, q = sol

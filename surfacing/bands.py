@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .analytic import AnalyticSurface, _in_plane, fit_circle
+from .analytic import AnalyticSurface, in_axis_frame, fit_circle
 from .flat import replace_faces
 
 __all__ = ["band_frame", "mesh_bands"]
@@ -82,7 +82,7 @@ def band_frame(surface: AnalyticSurface, boundary, curves, tol: float):
 def _cylindrical(p, origin, axis):
     """Height along the axis, distance from it and angle about it (any fixed frame) of
     points ``p`` (n, 3): three (n,) float64."""
-    x, y, z, _, _ = _in_plane(np.asarray(p, np.float64), axis, origin)
+    x, y, z, _, _ = in_axis_frame(np.asarray(p, np.float64), axis, origin)
     return z, np.hypot(x, y), np.arctan2(y, x)
 
 

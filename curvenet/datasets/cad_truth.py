@@ -136,21 +136,44 @@ def triangulate(shape, *, deflection: float = MESH_DEFLECTION):
 
 def shape_truth(shape) -> ShapeTruth:
     """Faces (kind, area), volume and triangulation of a solid."""
-    from ..cad.occ import area, volume
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
     faces = _faces(shape)
+    areas = []
+    for f in faces:
+        g = GProp_GProps()
+        BRepGProp.SurfaceProperties_s(f, g)
+        areas.append(g.Mass())
+    g = GProp_GProps()
+    BRepGProp.VolumeProperties_s(shape, g)
     V, T, TF = triangulate(shape)
-    return ShapeTruth([_kind(f) for f in faces], np.array([area(f) for f in faces]), volume(shape),
+    return ShapeTruth([_kind(f) for f in faces], np.asarray(areas, np.float64), float(g.Mass()),
                       V, T, TF, _diagonal(shape))
 
 
 def solid_check(shape) -> dict:
     """``solids`` (count), ``valid`` (``BRepCheck_Analyzer``), ``closed`` (no free edge),
     ``volume`` (total, ``BRepGProp``)."""
-    from OCP.TopAbs import TopAbs_SOLID
+    from OCP.BRepCheck import BRepCheck_Analyzer
+    from OCP.BRepGProp import BRepGProp
+    from OCP.GProp import GProp_GProps
+    from OCP.ShapeAnalysis import ShapeAnalysis_FreeBounds
+    from OCP.TopAbs import TopAbs_EDGE, TopAbs_SOLID
+    from OCP.TopExp import TopExp_Explorer
 
-    from ..cad.occ import count, free_edge_count, is_valid, volume
-    return {"solids": count(shape, TopAbs_SOLID), "valid": is_valid(shape),
-            "closed": free_edge_count(shape) == 0, "volume": volume(shape)}
+    def count(s, kind):
+        exp, k = TopExp_Explorer(s, kind), 0
+        while exp.More():
+            k += 1
+            exp.Next()
+        return k
+    fb = ShapeAnalysis_FreeBounds(shape, 1e-7)
+    free = count(fb.GetOpenWires(), TopAbs_EDGE) + count(fb.GetClosedWires(), TopAbs_EDGE)
+    g = GProp_GProps()
+    BRepGProp.VolumeProperties_s(shape, g)
+    return {"solids": count(shape, TopAbs_SOLID),
+            "valid": bool(BRepCheck_Analyzer(shape).IsValid()), "closed": free == 0,
+            "volume": float(g.Mass())}
 
 
 def score_against(truth: ShapeTruth, shape, mesh=None, *, seed: int = 0) -> dict:
