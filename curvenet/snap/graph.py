@@ -49,7 +49,9 @@ Pipeline of :func:`snap` (``mode="rough"``)
    runs from one to the other; nor does a closed stroke's seam (its two ends
    meeting) that has joined a junction the stroke passes through pull in a
    second one along the stroke (a ring stopping short between two crossings
-   would chain them).
+   would chain them); nor do two meetings of other strokes along it (two rings
+   close together, each crossing a meridian) whose strokes share none and stay
+   more than :data:`curvenet.snap.merge.APART` tol apart there.
 5. Corners: where a stroke turns by more than ``corner_angle`` between the
    chords ``tol * corner_window`` before and after a point (local maximum),
    and no junction is within ``2 tol``, it gets a degree-2 vertex. Where ``tol``

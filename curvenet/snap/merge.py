@@ -10,11 +10,19 @@ from __future__ import annotations
 import numpy as np
 from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
+from scipy.spatial import cKDTree
 
-__all__ = ["components", "first_items", "join_near"]
+__all__ = ["APART", "components", "first_items", "join_near"]
+
+#: Junctions within 1.5 tol along a stroke stay two when the other strokes of each stay
+#: more than this many tol from the other's (see :func:`join_near`). Between the two
+#: populations measured: rings of a torus drawn a third of its tube's radius apart lie
+#: 1.6 tol apart at the default tolerance; hand-drawn strokes 1.0-1.25 tol apart are
+#: mostly one line drawn twice, which merged junctions join (benchmarks/README.md).
+APART = 1.25
 
 
-def join_near(near, cid, gap, ends, held, L, tol):
+def join_near(near, cid, gap, ends, held, L, tol, around):
     """Candidate pairs ``(p, 2) int64`` that join the junctions of near pairs, closest first.
 
     ``near``: per pair of junctions ``j1, j2`` within ``1.5 tol`` along stroke ``k``, arrays
@@ -31,6 +39,12 @@ def join_near(near, cid, gap, ends, held, L, tol):
     updated in place. Nor do two junctions that strokes pass through merge
     along a short stroke that runs from one to the other (its start at one, its end at
     the other): a piece between two gaps, each next to a crossing, would chain the two.
+    Nor do two junctions that are each a meeting without ``k`` (two more stroke ends, or a
+    stroke passing through) merge along ``k`` when no stroke is at both and their other
+    strokes stay more than :data:`APART` tol apart near them (``around``: junction ->
+    ``(points (n, 3), strokes (n,) int64)``, the stroke samples within 2 tol of it): two
+    rings close together, each crossing a meridian, are two crossings, where a corner
+    whose pairwise contacts scattered is one.
     """
     (ds, kk, j1, j2), (ej, ek, only, end) = near, ends
     key = ej * len(L) + ek
@@ -41,6 +55,10 @@ def join_near(near, cid, gap, ends, held, L, tol):
     through = np.bincount(cid, weights=~gap) > 0  # some stroke passes through
     fi = first_items(cid)
     parent, out = {}, []
+    meets = {}  # junction -> {stroke: 2 passing through, 1 an end there}, for roots
+    for j, k, e in zip(ej.tolist(), ek.tolist(), end.tolist()):
+        meets.setdefault(j, {})[k] = 2 if e == 2 else 1
+    around = dict(around)
 
     def find(j):
         while parent.get(j, j) != j:
@@ -53,13 +71,24 @@ def join_near(near, cid, gap, ends, held, L, tol):
     def spans(k, a, b):  # stroke k starts at one junction and ends at the other
         return {int(end[np.searchsorted(key, j * len(L) + k)]) for j in (a, b)} == {0, 1}
 
+    def apart(k, ra, rb):  # two meetings without k whose strokes stay apart
+        wa = {q: w for q, w in meets.get(ra, {}).items() if q != k}
+        wb = {q: w for q, w in meets.get(rb, {}).items() if q != k}
+        if (min(sum(wa.values()), sum(wb.values())) < 2 or wa.keys() & wb.keys()
+                or ra not in around or rb not in around):
+            return False
+        (pa, sa), (pb, sb) = around[ra], around[rb]
+        pa, pb = pa[np.isin(sa, list(wa))], pb[np.isin(sb, list(wb))]
+        return bool(len(pa) and len(pb)
+                    and cKDTree(pa).query(pb)[0].min() > APART * tol)
+
     for x in np.lexsort((j2, j1, kk, ds)).tolist():
         k, a, b = int(kk[x]), int(j1[x]), int(j2[x])
         ra, rb = find(a), find(b)
         ha, hb = held.get(fi[ra], set()), held.get(fi[rb], set())
         if ra == rb or (k in ha and not gap_only(b, k)) or (k in hb and not gap_only(a, k)):
             continue
-        if through[ra] and through[rb] and spans(k, a, b):
+        if through[ra] and through[rb] and spans(k, a, b) or apart(k, ra, rb):
             continue
         new = ha | hb
         for jx, ry in ((a, rb), (b, ra)):  # a split joins a junction some stroke passes through
@@ -68,9 +97,14 @@ def join_near(near, cid, gap, ends, held, L, tol):
                 new |= {int(y) for y in ek[lo:lo + 2] if y != k and L[y] > 2.0 * tol}
             elif seam[jx] and through[ry]:  # a closed stroke's own ends: the stroke itself
                 new.add(k)
-        root = min(ra, rb)
-        parent[max(ra, rb)] = root
+        root, other = min(ra, rb), max(ra, rb)
+        parent[other] = root
         through[root] = through[ra] or through[rb]
+        for q, w in meets.pop(other, {}).items():
+            meets.setdefault(root, {})[q] = max(w, meets.get(root, {}).get(q, 0))
+        if root in around and other in around:
+            (p1, s1), (p2, s2) = around[root], around.pop(other)
+            around[root] = (np.vstack([p1, p2]), np.concatenate([s1, s2]))
         held[fi[root]] = new
         out.append((fi[a], fi[b]))
     return np.array(out, dtype=np.int64).reshape(-1, 2)

@@ -344,6 +344,26 @@ def test_short_piece_between_two_gaps_does_not_chain_two_crossings(length):
     assert abs(x[0]) < 0.5 * tol and abs(x[1] - x2) < 0.5 * tol
 
 
+@pytest.mark.parametrize("spacing", [1.45, 1.7])
+def test_two_crossings_of_stroke_ends_along_a_short_piece_stay_two(spacing):
+    """Two parallel lines ``spacing`` tol apart (rings close together) crossed by a third,
+    every line drawn in pieces that stop short of the crossings: two junctions of stroke
+    ends only, joined by the short piece between them. Within 1.5 tol along that piece
+    they were merged into one degree-6 vertex; the lines of the two junctions never meet,
+    so they stay two degree-4 vertices."""
+    tol = 0.025 * 2 * np.sqrt(2)
+    d, g = spacing * tol, 0.15 * tol
+    sk = Sketch([_line((-1, 0, 0), (-g, 0, 0), 80), _line((g, 0, 0), (1, 0, 0), 80),
+                 _line((-1, d, 0), (-g, d, 0), 80), _line((g, d, 0), (1, d, 0), 80),
+                 _line((0, -1, 0.01), (0, -g, 0.01), 80), _line((0, g, 0.01), (0, d - g, 0.01), 12),
+                 _line((0, d + g, 0.01), (0, 1, 0.01), 80)])
+    net = snap(sk, snap_tol=0.025)
+    deg = np.bincount(net.endpoints.ravel(), minlength=net.number_of_vertices)
+    assert sorted(deg.tolist()) == [1] * 6 + [4, 4]
+    y = np.sort(net.positions[deg == 4][:, 1])
+    assert abs(y[0]) < 0.5 * tol and abs(y[1] - d) < 0.5 * tol
+
+
 def test_junction_left_of_degree_two_by_a_sliver_merge_is_dissolved():
     """A stroke drawn a second time over part of a line, bulging 1.5 tol off it (too
     steep for overdraw, within the 2 tol of a sliver): its ends make two T-junctions on
