@@ -78,7 +78,12 @@ def join_near(near, cid, gap, ends, held, L, tol, around):
                 or ra not in around or rb not in around):
             return False
         (pa, sa), (pb, sb) = around[ra], around[rb]
+        on_k = np.vstack([pa[sa == k], pb[sb == k]])
         pa, pb = pa[np.isin(sa, list(wa))], pb[np.isin(sb, list(wb))]
+        if len(on_k):  # pieces continuing k (overshoots into the gap) do not count
+            k_tree = cKDTree(on_k)
+            pa = pa[k_tree.query(pa)[0] > 0.5 * tol] if len(pa) else pa
+            pb = pb[k_tree.query(pb)[0] > 0.5 * tol] if len(pb) else pb
         return bool(len(pa) and len(pb)
                     and cKDTree(pa).query(pb)[0].min() > APART * tol)
 
