@@ -12,8 +12,10 @@ Flow presets:
 
 - ``draft``: a short CPU run (64^3 grid, a 2 x 64 SIREN, 40 + 100 steps), about a
   minute per sketch on two cores.
-- ``default``: 128^3 and a 2 x 96 SIREN, 60 + 200 steps, then the polish; the better
-  choice on a GPU as well.
+- ``default``: 128^3 and a 2 x 96 SIREN, 60 + 140 steps, then the polish; the better
+  choice on a GPU as well. (200 full steps before: the reference rough sphere took 51 s
+  on two cores for the same F-score and Chamfer, and the vns sketches' median stroke
+  fidelity was 95.2% against 95.1%; ``benchmarks/README.md``.)
 - ``paper``: the published settings (Sec. 4.3, 5.1, 5.2): a 4 x 256 SIREN with
   omega_0 = 30, 10k / 15k / 15k Monte-Carlo samples on strokes, surface and volume,
   200 initialisation + 800 full Adam steps, a 256^3 grid on the bounding box padded by
@@ -192,8 +194,8 @@ PRESETS: dict[str, FlowConfig] = {
     "draft": FlowConfig(res=64, width=64, hidden_layers=2, n_stroke=1200, n_surface=1000,
                         n_volume=600, init_steps=40, steps=100, lr=3e-4, poisson_every=1,
                         w_smooth=0.1, attach=6.0),
-    "default": FlowConfig(w_smooth=0.1, polish=4, polish_rounds=4, polish_strip=1.0,
-                          average_from=0.6, attach=6.0),
+    "default": FlowConfig(steps=140, w_smooth=0.1, polish=4, polish_rounds=4,
+                          polish_strip=1.0, average_from=0.6, attach=6.0),
     "paper": FlowConfig(res=256, width=256, hidden_layers=4, n_stroke=10000, n_surface=15000,
                         n_volume=15000, init_steps=200, steps=800, lr=5e-5,
                         geometric_init_steps=0),
