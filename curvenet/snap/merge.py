@@ -42,9 +42,9 @@ def join_near(near, cid, gap, ends, held, L, tol, around):
     Nor do two junctions that are each a meeting without ``k`` (two more stroke ends, or a
     stroke passing through) merge along ``k`` when no stroke is at both and their other
     strokes stay more than :data:`APART` tol apart near them (``around``: junction ->
-    ``(points (n, 3), strokes (n,) int64)``, the stroke samples within 2 tol of it): two
-    rings close together, each crossing a meridian, are two crossings, where a corner
-    whose pairwise contacts scattered is one.
+    ``(points (n, 3), strokes (n,) int64)``, the samples within 2 tol of it of the strokes
+    that meet at the near junctions): two rings close together, each crossing a meridian,
+    are two crossings, where a corner whose pairwise contacts scattered is one.
     """
     (ds, kk, j1, j2), (ej, ek, only, end) = near, ends
     key = ej * len(L) + ek
@@ -105,8 +105,9 @@ def join_near(near, cid, gap, ends, held, L, tol, around):
         root, other = min(ra, rb), max(ra, rb)
         parent[other] = root
         through[root] = through[ra] or through[rb]
+        kept = meets.setdefault(root, {})
         for q, w in meets.pop(other, {}).items():
-            meets.setdefault(root, {})[q] = max(w, meets.get(root, {}).get(q, 0))
+            kept[q] = max(w, kept.get(q, 0))
         if root in around and other in around:
             (p1, s1), (p2, s2) = around[root], around.pop(other)
             around[root] = (np.vstack([p1, p2]), np.concatenate([s1, s2]))

@@ -269,7 +269,6 @@ def _cluster(samples, pos, mk, ms, tol, h):
     links = (cKDTree(pos).query_pairs(tol, output_type="ndarray") if m > 1
              else np.zeros((0, 2), dtype=np.int64))  # candidates joined
     Q, sid = samples[0], samples[1]
-    qtree = None
     mc = np.repeat(np.arange(m), 2)  # the candidate of each member
     L = samples[5].L
     gap = ((ms <= 0.5 * h) | (ms >= L[mk] - 0.5 * h)).all(axis=1)  # two stroke ends only
@@ -303,11 +302,12 @@ def _cluster(samples, pos, mk, ms, tol, h):
         lo_s, hi_s = np.minimum.reduceat(side, g), np.maximum.reduceat(side, g)
         ends = (j_o[g], k_o[g], np.logical_and.reduceat(gap[mc[order]], g),
                 np.where(lo_s == hi_s, lo_s, 2))  # stroke end there: 0 start, 1 end, 2 other
-        qtree = cKDTree(Q) if qtree is None else qtree
-        js = np.unique(np.concatenate([qj[:-1][near], qj[1:][near]])).tolist()
-        around = {j: (Q[i], sid[i]) for j, i in
-                  zip(js, (np.asarray(i, dtype=np.int64)
-                           for i in qtree.query_ball_point(J[js], 2.0 * tol)))}
+        # samples within 2 tol of the near junctions, of the strokes that meet there
+        js = np.unique(np.concatenate([qj[:-1][near], qj[1:][near]]))
+        mine = np.flatnonzero(np.isin(sid, ends[1][np.isin(ends[0], js)]))
+        around = {j: (Q[mine[i]], sid[mine[i]]) for j, i in
+                  zip(js.tolist(), (np.asarray(i, dtype=np.int64) for i in
+                                    cKDTree(Q[mine]).query_ball_point(J[js], 2.0 * tol)))}
         joined = join_near((np.diff(qs)[near], qk[1:][near], qj[:-1][near], qj[1:][near]),
                            cid, gap, ends, held, L, tol, around)
         if len(joined) == 0:
