@@ -5,7 +5,7 @@ splats as lumps a few grid cells wide, and sits off rough strokes where the fiel
 smoothing pulled it in between them. :func:`attach_to_strokes` moves the mesh vertices
 ``X`` to the minimiser of
 
-    ``|L X|^2_{M^-1} + alpha |X - V|^2_M + beta sum_s |B_s X - s|^2``
+    ``|L X|^2_{M^-1} + alpha |X - V|^2_M + sum_s beta_s |B_s X - t_s|^2``
 
 with ``L`` the cotangent Laplacian and ``M`` the Voronoi mass matrix of the extracted
 mesh ``V`` (libigl), ``B_s`` the barycentric row of the closest surface point of each
@@ -13,8 +13,17 @@ stroke sample ``s`` within ``reach`` grid cells: a linear low-pass of the surfac
 response to a ripple of wavenumber ``k`` is ``1 / (1 + k^4 / alpha)``, so
 ``alpha = (2 pi / (cutoff h))^4`` removes ripples shorter than ``cutoff`` cells ``h``
 and keeps the shape at larger scales without the shrinking of Laplacian smoothing)
-that also pulls the surface onto the strokes near it. ``beta = weight alpha h^2``: a
-stroke sample every cell weighs ``weight`` times a vertex's area term.
+that also pulls the surface onto the strokes near it.
+
+Every sample first pulls with ``beta = weight alpha h^2`` (a stroke sample every cell
+weighs ``weight`` times a vertex's area term) towards itself (``t_s = s``). The weaker
+the low-pass's data term (the longer the cutoff), the weaker that pull: a low-pass long
+enough to take out every lump would also let the surface sag off its strokes. So with
+a ``band``, the samples the solution leaves farther than ``band`` from the surface are
+then held :data:`HELD` times harder, towards the point at ``band`` from them on the
+way to the surface (a squared hinge on the distance, by iterated reweighting): the
+surface follows a stroke only as closely as the band asks, and the noise of a rough
+stroke within it is smoothed away like the lumps.
 """
 
 from __future__ import annotations
@@ -23,7 +32,12 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
-__all__ = ["attach_to_strokes"]
+__all__ = ["attach_to_strokes", "HELD"]
+
+#: How much harder a stroke sample outside the band pulls than the others.
+HELD = 1000.0
+#: Solves after the first, each holding the samples still outside the band.
+_HOLD_ROUNDS = 2
 
 
 def _barycentric(tri: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -34,11 +48,22 @@ def _barycentric(tri: np.ndarray, p: np.ndarray) -> np.ndarray:
     den = np.maximum(d00 * d11 - d01 * d01, np.finfo(np.float64).tiny)
     b1 = (d11 * d20 - d01 * d21) / den
     b2 = (d00 * d21 - d01 * d20) / den
-    return np.stack([1.0 - b1 - b2, b1, b2], axis=1)
+    b = np.clip(np.stack([1.0 - b1 - b2, b1, b2], axis=1), 0.0, 1.0)
+    total = b.sum(axis=1, keepdims=True)
+    # points in their triangles: in [0, 1] up to rounding; a degenerate triangle's 1/3 each
+    return np.where(total > 0, b / np.where(total > 0, total, 1.0), 1.0 / 3.0)
+
+
+def _solve(A, rhs) -> np.ndarray:
+    """``A^-1 rhs`` for a sparse symmetric positive definite ``A``."""
+    # a symmetric ordering and no pivoting (Cholesky's fill)
+    lu = splu(A.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
+              options={"SymmetricMode": True})
+    return np.asarray(lu.solve(rhs), np.float64)
 
 
 def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
-                      reach: float = 3.0) -> tuple[np.ndarray, dict]:
+                      band: float = 0.0, reach: float = 3.0) -> tuple[np.ndarray, dict]:
     """Fair the mesh ``(V, F)`` and pull it onto the stroke samples near it.
 
     Parameters
@@ -53,6 +78,9 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
         Ripples shorter than this many cells are removed (> 0).
     weight : float
         Pull of the stroke samples (>= 0; 0 = the low-pass alone).
+    band : float
+        Distance (model units) within which every pulled sample is held; 0 = no
+        holding, the pull ``weight`` alone. Ignored when ``weight`` is 0.
     reach : float
         Stroke samples farther than this many cells from the surface are left out.
 
@@ -61,8 +89,8 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
     X : (n, 3) float64
         The new vertex positions (``F`` unchanged).
     report : dict
-        ``samples`` (stroke samples drawn, one per cell of stroke length) and ``pulled``
-        (those within reach).
+        ``samples`` (stroke samples drawn, one per cell of stroke length), ``pulled``
+        (those within reach) and ``held`` (those held to the band).
     """
     import igl
 
@@ -76,15 +104,27 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
     S = np.concatenate([densify_polyline(np.asarray(s, np.float64), h) for s in strokes])
     d2, fi, closest = igl.point_mesh_squared_distance(S, V, F)
     near = np.sqrt(np.maximum(d2, 0.0)) < reach * h
-    S, fi = S[near], fi[near]
-    bc = _barycentric(V[F[fi]], closest[near])
-    B = sp.csr_matrix((bc.ravel(), (np.repeat(np.arange(len(S)), 3), F[fi].ravel())),
-                      shape=(len(S), len(V)))
-    beta = weight * alpha * h * h
-    A = (L.T @ sp.diags(1.0 / m) @ L + alpha * sp.diags(m) + beta * (B.T @ B)).tocsc()
-    rhs = alpha * (m[:, None] * V) + beta * (B.T @ S)
-    # symmetric positive definite: a symmetric ordering and no pivoting (Cholesky's fill)
-    lu = splu(A, permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0,
-              options={"SymmetricMode": True})
-    X = np.asarray(lu.solve(rhs), np.float64).reshape(V.shape)
-    return X, {"samples": int(len(near)), "pulled": int(near.sum())}
+    S, d2, fi, closest = S[near], d2[near], fi[near], closest[near]
+    K = L.T @ sp.diags(1.0 / m) @ L + alpha * sp.diags(m)
+    base = alpha * (m[:, None] * V)
+    beta = np.full(len(S), weight * alpha * h * h)
+    X, held = V, np.zeros(len(S), bool)
+    for r in range(1 + (_HOLD_ROUNDS if band > 0 and weight > 0 else 0)):
+        if r:   # the samples the last solve left outside the band join the held ones
+            d2, fi, closest = igl.point_mesh_squared_distance(S, X, F)
+            out = np.sqrt(np.maximum(d2, 0.0)) > band
+            if not out[~held].any():
+                break
+            held |= out
+        # each sample's closest point on the surface as it is now, as barycentric rows
+        B = sp.csr_matrix((_barycentric(X[F[fi]], closest).ravel(),
+                           (np.repeat(np.arange(len(S)), 3), F[fi].ravel())),
+                          shape=(len(S), len(V)))
+        dist = np.sqrt(np.maximum(d2, 0.0))
+        # each held sample pulls to the point within `band` of it on the way to the surface
+        frac = np.where(held, np.minimum(dist, band) / np.maximum(dist, 1e-300), 0.0)
+        target = S + frac[:, None] * (closest - S)
+        w = np.where(held, HELD * beta, beta)
+        X = _solve(K + B.T @ sp.diags(w) @ B, base + B.T @ (w[:, None] * target))
+    X = X.reshape(V.shape)
+    return X, {"samples": int(len(near)), "pulled": int(near.sum()), "held": int(held.sum())}

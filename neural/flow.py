@@ -69,10 +69,12 @@ Engineering choices (documented deviations / gap fills)
   dropped (spurious level-set components of the periodic f).
 * ``attach > 0`` (draft, default): the extracted mesh is faired and pulled onto the
   strokes near it (:mod:`neural.attach`, a stroke-constrained bi-Laplacian low-pass of
-  the vertices), and returned so only when its stroke fidelity is at least the
-  extracted mesh's. ``FlowResult.f_grid`` stays the field whose zero set was
-  extracted. Not with ``anchors``: a fill beside classical patches must meet their
-  surface, which the fairing does not see (the hybrid route closes that seam itself).
+  the vertices; the stroke samples it leaves farther than ``attach_band`` of the
+  strokes' diagonal are held to that band), and returned so only when its stroke
+  fidelity is at least the extracted mesh's. ``FlowResult.f_grid`` stays the field
+  whose zero set was extracted. Not with ``anchors``: a fill beside classical patches
+  must meet their surface, which the fairing does not see (the hybrid route closes
+  that seam itself).
 * ``anchors`` (not in the paper): oriented points of another surface the fit must
   meet (a hybrid fill beside classical patches). Each step draws
   ``min(m, n_stroke)`` of them; they join the stroke samples in the data term
@@ -293,8 +295,10 @@ def _attached(V, F, strokes, h_world, cfg: FlowConfig, before: float | None = No
     holds at least as much of them; ``(V, {"fidelity": [before, after], "kept": bool,
     "samples", "pulled"})``. ``before``: the stroke fidelity of ``(V, F)`` when known."""
     from .attach import attach_to_strokes
+    pts = np.concatenate(strokes)
+    band = cfg.attach_band * float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
     X, rep = attach_to_strokes(V, F, strokes, h_world, cutoff=cfg.attach,
-                               weight=cfg.attach_weight)
+                               weight=cfg.attach_weight, band=band)
     if before is None:
         before = _fidelity(V, F, strokes)
     fidelity = [before, _fidelity(X, F, strokes)]

@@ -39,9 +39,14 @@ from the paper in:
   surfaces between their strokes, and the polish takes that back where it does not
   move the surface off the strokes.
 
-Both also fair the extracted mesh onto the strokes (``attach``, ripples under 6 cells
-removed): the zero set carries the splats' Monte-Carlo lumps and lies off rough
-strokes, which the fields' extra training does not take away.
+Both also fair the extracted mesh onto the strokes (``attach``): the zero set carries
+the splats' Monte-Carlo lumps and lies off rough strokes, which the fields' extra
+training does not take away. Ripples shorter than about 16 % of the padded box's side
+are removed (20 cells at ``default``, 10 at ``draft``), and the strokes are held to within half the
+stroke-fidelity tolerance (``attach_band``). A 6-cell cutoff with the pull alone
+(before) left the surfaces 3-6 times rougher by the local-quadric measure and further
+from the classical surfaces; a long cutoff with the pull alone let the surface sag off
+its strokes (``benchmarks/README.md``).
 
 Crease presets: ``draft`` for a CPU, ``default`` a 4 x 256 MLP trained 3,000 steps,
 ``paper`` the network size and the 15,000 steps of the paper's 3D examples (Sec. 5),
@@ -151,6 +156,10 @@ class FlowConfig:
         Not in the paper.
     attach_weight : float
         Pull of the stroke samples in that fairing (0 = the low-pass alone).
+    attach_band : float
+        In that fairing, the stroke samples left farther than this fraction of the
+        strokes' bounding-box diagonal from the surface are held to it (0 = the pull
+        alone); half the stroke-fidelity tolerance in ``draft`` and ``default``.
     """
 
     res: int = 128
@@ -184,6 +193,7 @@ class FlowConfig:
     average_from: float = 1.0
     attach: float = 0.0
     attach_weight: float = 100.0
+    attach_band: float = 0.0
 
     def as_dict(self) -> dict:
         """The settings as a plain dict (for reports)."""
@@ -193,9 +203,10 @@ class FlowConfig:
 PRESETS: dict[str, FlowConfig] = {
     "draft": FlowConfig(res=64, width=64, hidden_layers=2, n_stroke=1200, n_surface=1000,
                         n_volume=600, init_steps=40, steps=100, lr=3e-4, poisson_every=1,
-                        w_smooth=0.1, attach=6.0),
+                        w_smooth=0.1, attach=10.0, attach_band=0.005),
     "default": FlowConfig(steps=140, w_smooth=0.1, polish=4, polish_rounds=4,
-                          polish_strip=1.0, average_from=0.6, attach=6.0),
+                          polish_strip=1.0, average_from=0.6, attach=20.0,
+                          attach_band=0.005),
     "paper": FlowConfig(res=256, width=256, hidden_layers=4, n_stroke=10000, n_surface=15000,
                         n_volume=15000, init_steps=200, steps=800, lr=5e-5,
                         geometric_init_steps=0),
@@ -260,7 +271,7 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
         if not getattr(cfg, name) > 0:
             raise ValueError(f"{name} must be positive, got {getattr(cfg, name)!r}")
     for name in ("w_align", "w_smooth", "w_data", "w_eik", "w_curl", "w_normal", "grad_clip",
-                 "polish_strip", "attach", "attach_weight"):
+                 "polish_strip", "attach", "attach_weight", "attach_band"):
         if not getattr(cfg, name) >= 0:
             raise ValueError(f"{name} must be non-negative, got {getattr(cfg, name)!r}")
     for name in ("normalize_from", "average_from"):

@@ -1,6 +1,6 @@
 """The stroke-constrained fairing of the extracted mesh (neural.attach): on a shrunken,
 bumpy sphere with great-circle strokes of the true one it removes the bumps and brings the
-surface back onto the strokes."""
+surface back onto the strokes; with a band it holds them where a weak pull does not."""
 
 import numpy as np
 import trimesh
@@ -10,20 +10,26 @@ from curvenet.evaluate import roughness
 from curvenet.neural.attach import attach_to_strokes
 
 
-def test_attach_takes_bumps_out_and_the_surface_onto_the_strokes():
+def _bumpy_sphere():
+    """An icosphere shrunk 4% with bumps: vertices (n, 3) and faces (m, 3)."""
     s = trimesh.creation.icosphere(5)
     n = s.vertices / np.linalg.norm(s.vertices, axis=1)[:, None]
     bumps = 0.01 * (np.sin(40 * n[:, 0]) * np.sin(40 * n[:, 1]))[:, None] * n
-    V = 0.96 * n + bumps                                   # shrunk 4% and bumpy
+    return 0.96 * n + bumps, s.faces
+
+
+def test_attach_takes_bumps_out_and_the_surface_onto_the_strokes():
+    V, faces = _bumpy_sphere()
+    n = V / np.linalg.norm(V, axis=1)[:, None]
     t = np.linspace(0, 2 * np.pi, 400)
     strokes = [np.c_[np.cos(t), np.sin(t), 0 * t], np.c_[np.cos(t), 0 * t, np.sin(t)],
                np.c_[0 * t, np.cos(t), np.sin(t)]]
     h = 0.05                                               # a grid cell of the extraction
-    X, rep = attach_to_strokes(V, s.faces, strokes, h, cutoff=6.0, weight=100.0)
+    X, rep = attach_to_strokes(V, faces, strokes, h, cutoff=6.0, weight=100.0)
     assert rep["pulled"] == rep["samples"] > 0             # every sample within 3 cells
-    before, after = (stroke_fidelity((P, s.faces), strokes)["fidelity"] for P in (V, X))
+    before, after = (stroke_fidelity((P, faces), strokes)["fidelity"] for P in (V, X))
     assert before < 0.1 and after > 0.95
-    assert roughness((X, s.faces))["median"] < 0.5 * roughness((V, s.faces))["median"]
+    assert roughness((X, faces))["median"] < 0.5 * roughness((V, faces))["median"]
     # nearer the true sphere next to the strokes, and no farther elsewhere (between
     # the strokes the fairing keeps the extracted shape: it pulls, it does not inflate)
     near = np.min(np.abs(n), axis=1) < 2 * h                # within 2 cells of a circle
@@ -32,7 +38,30 @@ def test_attach_takes_bumps_out_and_the_surface_onto_the_strokes():
     assert err[1][~near].mean() < err[0][~near].mean()
     # far strokes are left out, and a zero pull is the low-pass alone
     far = [np.c_[3 + np.cos(t), np.sin(t), 0 * t]]
-    Y, rep = attach_to_strokes(V, s.faces, far, h, cutoff=6.0, weight=100.0)
+    Y, rep = attach_to_strokes(V, faces, far, h, cutoff=6.0, weight=100.0)
     assert rep["pulled"] == 0
-    Z, _ = attach_to_strokes(V, s.faces, strokes, h, cutoff=6.0, weight=0.0)
+    Z, _ = attach_to_strokes(V, faces, strokes, h, cutoff=6.0, weight=0.0)
     np.testing.assert_allclose(Y, Z, atol=1e-9)
+
+
+def test_a_band_holds_the_strokes_that_a_weak_pull_lets_the_surface_sag_off():
+    import igl
+    V, F = _bumpy_sphere()
+    V = V * (0.92 / 0.96)                             # shrunk 8%: 1.6 cells off
+    t = np.linspace(0, 2 * np.pi, 400)
+    rng = np.random.default_rng(0)
+    # strokes on the true sphere, noisy along its normal by 0.2% of its radius
+    strokes = [c * (1 + 0.002 * rng.standard_normal(len(t)))[:, None]
+               for c in (np.c_[np.cos(t), np.sin(t), 0 * t], np.c_[np.cos(t), 0 * t, np.sin(t)],
+                         np.c_[0 * t, np.cos(t), np.sin(t)])]
+    h, band = 0.05, 0.005 * np.sqrt(12.0)          # band: 0.5% of the strokes' diagonal
+    loose, rep0 = attach_to_strokes(V, F, strokes, h, cutoff=20.0, weight=1.0)
+    X, rep = attach_to_strokes(V, F, strokes, h, cutoff=20.0, weight=1.0, band=band)
+    assert rep0["held"] == 0 and rep["held"] > 0.9 * rep["pulled"]
+    dist = [np.sqrt(igl.point_mesh_squared_distance(np.concatenate(strokes), P, F)[0])
+            for P in (loose, X)]
+    assert np.percentile(dist[0], 90) > 3 * band    # the weak pull alone: sagged off
+    assert np.percentile(dist[1], 90) < 1.25 * band
+    # held as a band, not onto every sample: the strokes' noise does not come back
+    assert roughness((X, F))["median"] < 1.5 * roughness((loose, F))["median"]
+    assert roughness((X, F))["median"] < 0.1 * roughness((V, F))["median"]
