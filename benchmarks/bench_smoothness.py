@@ -5,8 +5,8 @@ Run from the repository root::
     nice -n 5 python benchmarks/bench_smoothness.py --out smooth.tsv
         [--sketches vns/torus,cassie/01-0-1] [--quality draft] [--threads 2]
 
-Each sketch (default: the 22 of ``$CURVENET_DATA/sketches/vns``; ``--sketches`` takes
-``SET/STEM`` names of ``vns`` and ``cassie``) is surfaced twice:
+Each sketch (default: the 22 of ``$CURVENET_DATA/sketches/vns``, ``input/`` included;
+``--sketches`` takes ``SET/STEM`` names of ``vns`` and ``cassie``) is surfaced twice:
 ``curvenet.surface(path, method="classical")`` and ``method="neural"`` at ``--quality``.
 One row per sketch (appended as soon as it is done): for each surface the seconds, the
 stroke fidelity of the surface alone (share of stroke length within 1% of the sketch's
@@ -62,7 +62,9 @@ def _row(name: str, path: Path, quality: str) -> dict:
 
 def _paths(names):
     if not names:
-        return [(f"vns/{p.stem}", p) for p in sorted((DATA / SETS["vns"][0]).glob("*.obj"))]
+        root = DATA / SETS["vns"][0]
+        return [(f"vns/{p.relative_to(root).with_suffix('').as_posix()}", p)
+                for p in sorted(root.rglob("*.obj"))]
     out = []
     for name in names:
         set_name, stem = name.split("/", 1)
