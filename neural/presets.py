@@ -42,11 +42,11 @@ from the paper in:
 Both also fair the extracted mesh onto the strokes (``attach``): the zero set carries
 the splats' Monte-Carlo lumps and lies off rough strokes, which the fields' extra
 training does not take away. Ripples shorter than about 16 % of the padded box's side
-are removed (20 cells at ``default``, 10 at ``draft``), and the strokes are held to within half the
-stroke-fidelity tolerance (``attach_band``). A 6-cell cutoff with the pull alone
-(before) left the surfaces 3-6 times rougher by the local-quadric measure and further
-from the classical surfaces; a long cutoff with the pull alone let the surface sag off
-its strokes (``benchmarks/README.md``).
+are removed (20 cells at ``default``, 10 at ``draft``), and the strokes are held to
+within half the stroke-fidelity tolerance (``attach_band``). A short cutoff with the
+pull alone (6 cells, before) left the surfaces several times rougher by the
+local-quadric measure and further from the classical surfaces; a long cutoff with the
+pull alone let the surface sag off its strokes (figures: ``benchmarks/README.md``).
 
 Crease presets: ``draft`` for a CPU, ``default`` a 4 x 256 MLP trained 3,000 steps,
 ``paper`` the network size and the 15,000 steps of the paper's 3D examples (Sec. 5),
