@@ -103,16 +103,18 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
     alpha = (2.0 * np.pi / (cutoff * h)) ** 4
     S = np.concatenate([densify_polyline(np.asarray(s, np.float64), h) for s in strokes])
     d2, fi, closest = igl.point_mesh_squared_distance(S, V, F)
-    near = np.sqrt(np.maximum(d2, 0.0)) < reach * h
-    S, d2, fi, closest = S[near], d2[near], fi[near], closest[near]
+    dist = np.sqrt(np.maximum(d2, 0.0))
+    near = dist < reach * h
+    S, dist, fi, closest = S[near], dist[near], fi[near], closest[near]
     K = L.T @ sp.diags(1.0 / m) @ L + alpha * sp.diags(m)
     base = alpha * (m[:, None] * V)
-    beta = np.full(len(S), weight * alpha * h * h)
+    beta = weight * alpha * h * h
     X, held = V, np.zeros(len(S), bool)
     for r in range(1 + (_HOLD_ROUNDS if band > 0 and weight > 0 else 0)):
         if r:   # the samples the last solve left outside the band join the held ones
             d2, fi, closest = igl.point_mesh_squared_distance(S, X, F)
-            out = np.sqrt(np.maximum(d2, 0.0)) > band
+            dist = np.sqrt(np.maximum(d2, 0.0))
+            out = dist > band
             if not out[~held].any():
                 break
             held |= out
@@ -120,11 +122,9 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
         B = sp.csr_matrix((_barycentric(X[F[fi]], closest).ravel(),
                            (np.repeat(np.arange(len(S)), 3), F[fi].ravel())),
                           shape=(len(S), len(V)))
-        dist = np.sqrt(np.maximum(d2, 0.0))
         # each held sample pulls to the point within `band` of it on the way to the surface
         frac = np.where(held, np.minimum(dist, band) / np.maximum(dist, 1e-300), 0.0)
         target = S + frac[:, None] * (closest - S)
         w = np.where(held, HELD * beta, beta)
         X = _solve(K + B.T @ sp.diags(w) @ B, base + B.T @ (w[:, None] * target))
-    X = X.reshape(V.shape)
     return X, {"samples": int(len(near)), "pulled": int(near.sum()), "held": int(held.sum())}

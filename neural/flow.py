@@ -293,7 +293,7 @@ def _polished(fit: FlowFit, f, mesh, strokes, labels, cut_boundary):
 def _attached(V, F, strokes, h_world, cfg: FlowConfig, before: float | None = None):
     """The mesh faired onto its strokes (:func:`neural.attach.attach_to_strokes`) if it
     holds at least as much of them; ``(V, {"fidelity": [before, after], "kept": bool,
-    "samples", "pulled"})``. ``before``: the stroke fidelity of ``(V, F)`` when known."""
+    "samples", "pulled", "held"})``. ``before``: the stroke fidelity of ``(V, F)`` when known."""
     from .attach import attach_to_strokes
     pts = np.concatenate(strokes)
     band = cfg.attach_band * float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
