@@ -9,9 +9,13 @@ comes out flattened). :func:`sweep_grid` instead transports the patch's profiles
 
 * **Profile pair** (left ``c3`` and right ``c1``, say): the similarity ``M = (s, R)``
   that best maps the left profile onto the right one (Umeyama's least-squares fit of
-  corresponding arc-length samples, centred) is split into its powers ``M^u``; at
-  ``u`` the left profile carried by ``M^u`` and the right one carried back by
-  ``M^(u-1)`` are blended ``(1 - u) : u``.
+  corresponding arc-length samples, centred) is split into its powers ``M^u``. Both
+  profiles are read as one common shape ``a*`` plus each one's own part: ``a*`` is
+  the shape nearest to both in the least-squares sense, ``(a + s R^T b) / (1 + s^2)``
+  (``a``, ``b`` the centred profiles), and the own parts are ``a - a*`` and
+  ``b - M a*``. At ``u`` the profile is ``M^u a*`` plus the own parts blended
+  ``(1 - u) : u``, each turned by the rotation of ``M^u`` (or ``M^(u-1)``) but not
+  scaled.
 * **Rails** (bottom ``c0`` and top ``c2``): the blended profile is placed on the rail
   points ``c0(u)``, ``c2(u)`` by the similarity that maps its chord onto theirs with
   the smallest rotation (scale, rotation, translation).
@@ -24,6 +28,14 @@ patch is reproduced from its boundary alone.
 
 Notes
 -----
+Why the own parts are not scaled: a stroke's wobble has the same size on a small
+profile as on a large one. Carried as part of the small profile's shape and scaled up
+with it (the first version: each profile carried whole by ``M^u`` and blended), it grew
+in proportion between them: the inner ring of a torus, a third of the outer one, put
+its wobble into the patch up to three times larger. Split off and carried at its own
+size, it stays within the profiles' own deviation; profiles related by a similarity
+have no own part and are carried exactly as before.
+
 Not in Orbay & Kara 2011, whose control mesh is sampled from the Coons patch: the
 swept grid is the *rest shape* of the ``sweep`` fit (:func:`surfacing.fit.fit_lsq`'s
 ``rest``), which keeps the shape it implies between sparse curves, and the ``auto``
@@ -196,12 +208,16 @@ def transport(A, B, rail0, rail1) -> np.ndarray:
     angle = _turn_with_the_rails(A, axis, angle, rail0, rail1, u)[..., None]  # (..., 1)
     a = A - A.mean(axis=-2, keepdims=True)
     b = B - B.mean(axis=-2, keepdims=True)
-    s = s[..., None, None, None]
-    Xa = s ** u[:, None, None] * np.einsum("...kij,...mj->...kmi", rotations(axis, u * angle), a)
-    Xb = s ** (u - 1.0)[:, None, None] * np.einsum(
-        "...kij,...mj->...kmi", rotations(axis, (u - 1.0) * angle), b)
+    # the common shape, each profile's own part left absolute (see the module's notes)
+    sc = s[..., None, None]
+    common = (a + sc * np.einsum("...ji,...mj->...mi", R, b)) / (1.0 + sc * sc)
+    own_a = a - common
+    own_b = b - sc * np.einsum("...ij,...mj->...mi", R, common)
+    fwd = rotations(axis, u * angle)                                       # (..., n, 3, 3)
     w = u[:, None, None]
-    X = (1.0 - w) * Xa + w * Xb                                             # (..., n, m, 3)
+    X = (s[..., None, None, None] ** w * np.einsum("...kij,...mj->...kmi", fwd, common)
+         + (1.0 - w) * np.einsum("...kij,...mj->...kmi", fwd, own_a)
+         + w * np.einsum("...kij,...mj->...kmi", rotations(axis, (u - 1.0) * angle), own_b))
     da = X[..., -1, :] - X[..., 0, :]
     db = rail1 - rail0
     la = np.linalg.norm(da, axis=-1)

@@ -94,6 +94,28 @@ def test_transport_carries_one_profile_to_the_other_on_the_rails():
     assert s_fit == pytest.approx(0.5) and np.allclose(R, rot)
 
 
+def test_a_small_profile_s_own_wobble_is_not_scaled_up_on_the_way():
+    """A cone frustum whose small end (a quarter of the large one) is drawn with a bump:
+    between the ends the patch stays within the bump's height of the true cone. Carried
+    as a part of the small profile's shape, the bump grew with the profile (to 1.3 times
+    its height halfway)."""
+    th = np.linspace(0, np.pi, 17)
+
+    def half_ring(rad, h):
+        return np.stack([rad * np.cos(th), rad * np.sin(th), np.full_like(th, h)], 1)
+
+    u = np.linspace(0, 1, 9)
+    rad = 1.0 - 0.75 * u
+    bump = 0.01
+    B = half_ring(0.25, 1.0) + bump * np.sin(th)[:, None] ** 2 * [0, 0, 1]
+    out = transport(half_ring(1.0, 0.0), B, np.stack([rad, 0 * u, u], 1),
+                    np.stack([-rad, 0 * u, u], 1))
+    truth = np.stack([half_ring(r, h) for r, h in zip(rad, u)])
+    off = np.linalg.norm(out - truth, axis=-1).max(axis=-1)
+    assert off[-1] == pytest.approx(bump)
+    assert off.max() <= bump * (1 + 1e-9)
+
+
 def test_degenerate_profiles_give_finite_patches():
     """A closed profile (zero chord) and profiles a half turn apart are still patches."""
     t = np.linspace(0, 2 * np.pi, 13)
