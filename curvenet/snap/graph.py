@@ -41,7 +41,12 @@ Pipeline of :func:`snap` (``mode="rough"``)
 4. Every other contact is a junction candidate at its closest sample pair:
    the midpoint for a crossing or two ends (gap), the point on the other stroke
    for an end touching a stroke interior (T-junction). A stroke whose two ends
-   are within ``tol`` is closed. Candidates within ``tol`` of each other are
+   are within ``tol`` is closed. An end within ``tol`` of its own stroke's interior,
+   farther than ``2 pi tol`` from it along the stroke and ``trim * tol`` from the
+   other end, is a T-junction there too (a stem drawn on round a ring in one stroke:
+   a "P"), unless the other end touches the stroke too (an "alpha") or the stroke's
+   last ``overdraw_length * tol`` runs beside that interior (a spiral, a fold).
+   Candidates within ``tol`` of each other are
    merged (connected components) into one junction at their mean, and so are
    junctions within ``1.5 tol`` along one stroke, closest first; a gap (two
    stroke ends) that has joined a junction does not pull in a second one, nor
@@ -91,9 +96,8 @@ unit-box inputs give the same network up to scale. Deterministic: no random
 numbers; ties are broken by stroke and sample order.
 
 Not handled (documented gaps): a stroke crossing itself in its interior stays
-one piece there; an end touching its own stroke's interior is not snapped, unless
-it is a loop drawn past its start (step 3); a stroke drawn round two or more times
-(an overlap over 15% of its length) stays as drawn.
+one piece there; a stroke drawn round two or more times (an overlap over 15% of its
+length) stays as drawn.
 
 Departure from Abbasinejad et al. (Sec. 6.1): the paper snaps pairs of curves
 ("two curves intersect when they pass within a user-defined threshold") and

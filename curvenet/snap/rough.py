@@ -174,7 +174,7 @@ def _unchanged(before, after):
 
 
 # --------------------------------------------------------------------------- junctions
-def _candidates(st, samples, con, tol, h):
+def _candidates(st, samples, con, tol, h, opts):
     """Junction candidates: positions ``(m, 3)``, the two member strokes ``(m, 2) int64``
     and arc parameters on them ``(m, 2) float64`` of each, and the number of closed strokes.
 
@@ -207,15 +207,87 @@ def _candidates(st, samples, con, tol, h):
     end_b = (sb <= 0.5 * h) | (sb >= flat.L[b] - 0.5 * h)
     pos = np.where((end_a & ~end_b)[:, None], pb,
                    np.where((end_b & ~end_a)[:, None], pa, 0.5 * (pa + pb)))
+    own = _own_touches(samples, tol, h, opts.overdraw_length * tol, opts.trim * tol)
+    pos = np.vstack([pos, own[0]])
+    mk0 = np.concatenate([np.stack([a, b], axis=1), own[1]])
+    ms0 = np.concatenate([np.stack([sa, sb], axis=1), own[2]])
     closed = [k for k in range(len(st))  # closed strokes: the two ends meet
               if st.length(k) > 4.0 * tol and np.linalg.norm(st.polys[k][0] - st.polys[k][-1])
               <= tol]
     ends = np.array([[st.polys[k][0], st.polys[k][-1]] for k in closed]).reshape(-1, 2, 3)
     pos = np.vstack([pos, 0.5 * (ends[:, 0] + ends[:, 1])])
-    mk = np.concatenate([np.stack([a, b], axis=1), np.repeat(closed, 2).reshape(-1, 2)])
-    ms = np.concatenate([np.stack([sa, sb], axis=1),
-                         np.array([[0.0, st.length(k)] for k in closed]).reshape(-1, 2)])
+    mk = np.concatenate([mk0, np.repeat(closed, 2).reshape(-1, 2)])
+    ms = np.concatenate([ms0, np.array([[0.0, st.length(k)] for k in closed]).reshape(-1, 2)])
     return pos, mk.astype(np.int64), ms.astype(np.float64), len(closed)
+
+
+def _own_touches(samples, tol, h, run, margin):
+    """T-junctions of a stroke's end on its own interior (a ruling drawn on round its
+    ring in one stroke: a "P").
+
+    An end of a stroke that is not closed touches its own stroke where a sample farther
+    than ``2 pi tol`` from it along the stroke (a loop narrower than ``2 tol`` is a curl
+    of the pen, not a face) and more than ``margin`` (``trim * tol``) from the other end
+    lies within ``tol`` of it (nearer, the rest would be trimmed as an overshoot: a ring
+    nearly closed). Only one end may touch: a stroke whose two ends both touch it (a
+    ring whose run past its start crosses its beginning, an "alpha") stays as drawn; so
+    does one whose last ``run`` (``overdraw_length * tol``) runs along that interior
+    within ``tol`` all the way (drawn back over itself: a spiral's turns side by side, a
+    fold). The junction lands on the interior, as a T-junction lands on the through
+    stroke.
+
+    Returns
+    -------
+    pos : (t, 3) float64; mk : (t, 2) int64 (the stroke, twice); ms : (t, 2) float64
+        (the end's arc parameter, the interior's).
+    """
+    Q, sid, ss, _, start, flat = samples
+    none = (np.zeros((0, 3)), np.zeros((0, 2), np.int64), np.zeros((0, 2)))
+    k = np.flatnonzero(flat.L > 4.0 * tol)
+    k = k[np.linalg.norm(flat.interp(k, np.zeros(len(k))) - flat.interp(k, flat.L[k]), axis=1)
+          > tol]                                                  # closed strokes: their rule
+    if len(k) == 0:
+        return none
+    k2 = np.repeat(k, 2)
+    s_end = np.where(np.arange(len(k2)) % 2 == 0, 0.0, flat.L[k2])
+    near = cKDTree(flat.interp(k2, s_end)).sparse_distance_matrix(
+        cKDTree(Q), tol, output_type="ndarray")
+    e, j = near["i"].astype(np.int64), near["j"].astype(np.int64)
+    L = flat.L[k2[e]]
+    ok = ((sid[j] == k2[e]) & (np.abs(ss[j] - s_end[e]) > 2.0 * np.pi * tol)
+          & (ss[j] > margin) & (ss[j] < L - margin))
+    if not ok.any():
+        return none
+    e, j, d = e[ok], j[ok], near["v"][ok]
+    order = np.lexsort((d, e))
+    first = np.concatenate([[True], e[order][1:] != e[order][:-1]])
+    e, j = e[order][first], j[order][first]
+    one = np.bincount(k2[e], minlength=len(flat.L))[k2[e]] == 1    # both ends: an "alpha"
+    e, j = e[one], j[one]
+    if len(e) == 0:
+        return none
+    ke, se, sj = k2[e], s_end[e], ss[j]
+    # the end's last `run`, point by point, against the interior around the contact
+    inward = np.where(se == 0.0, 1.0, -1.0)
+    steps = np.arange(1.0, np.ceil(run / tol) + 1.0) * tol                    # (r,)
+    sp = np.clip(se[:, None] + inward[:, None] * steps, 0.0, flat.L[ke][:, None])
+    kr, sp = np.repeat(ke, len(steps)), sp.ravel()
+    reach = run + tol
+    lo = np.repeat(sj - reach, len(steps))
+    hi = np.repeat(sj + reach, len(steps))
+    away = np.repeat(inward, len(steps)) > 0                 # the end is the start: stay after it
+    lo = np.where(away, np.maximum(lo, sp + 2.0 * tol), lo)
+    hi = np.where(away, hi, np.minimum(hi, sp - 2.0 * tol))
+    pts = flat.interp(kr, sp)
+    beside = np.linalg.norm(
+        flat.interp(kr, _closest_params(samples, kr, lo, np.maximum(hi, lo), pts, h)) - pts,
+        axis=1) <= tol
+    keep = ~beside.reshape(len(ke), len(steps)).all(axis=1)
+    if not keep.any():
+        return none
+    ke, se, sj = ke[keep], se[keep], sj[keep]
+    s_in = _closest_params(samples, ke, sj - h, sj + h, flat.interp(ke, se), h)
+    return flat.interp(ke, s_in), np.stack([ke, ke], axis=1), np.stack([se, s_in], axis=1)
 
 
 def _closest_params(samples, k, lo, hi, target, h):
@@ -435,7 +507,7 @@ def snap_rough(strokes, src, labels, diag, opts) -> CurveNetwork:
     total = sum(st.length(k) for k in range(len(st)))
     h = max(0.25 * tol, total / _MAX_SAMPLES)
     st, samples, con = _overdraw_rounds(st, tol, h, opts, report)
-    pos, mk, ms, report["closed_strokes"] = _candidates(st, samples, con, tol, h)
+    pos, mk, ms, report["closed_strokes"] = _candidates(st, samples, con, tol, h, opts)
     J, per_stroke = _cluster(samples, pos, mk, ms, tol, h)
     nj = len(J)
     verts = [p for p in J]

@@ -1,5 +1,6 @@
 """Snapping loops drawn past their own start or short of it (issue 33): one closed loop
-with the overlap averaged; spirals and hooks stay as drawn; redraws of the class."""
+with the overlap averaged; spirals stay as drawn; a stroke's end on its own interior is a
+T-junction; redraws of the class."""
 
 from __future__ import annotations
 
@@ -112,6 +113,21 @@ def test_stroke_touching_only_the_run_past_the_start_stays_attached():
     assert _degrees(net) == [1, 3] and net.number_of_edges == 2
     assert net.report["overdrawn_loops"] == 1 and net.report["t_junctions"] == 1
 
+@pytest.mark.parametrize("gap", [-0.9, -0.5, 0.5])
+def test_a_stroke_ending_on_its_own_interior_is_a_t_junction(gap):
+    """A "P": a stem drawn on round a unit ring in one stroke, the ring stopping 0.9 or
+    0.5 TOL short of the corner or running 0.5 TOL past it. Its end is a T-junction on
+    its own stroke: a loop and a stem meeting at one vertex of degree 3 (before: the
+    ring's end dangled and the corner was a vertex of degree 2, so the ring bounded no
+    face)."""
+    t = np.linspace(0, 2 * np.pi + gap * TOL, 600)
+    net = _snap(np.vstack([_line((1.8, 0, 0), (1, 0, 0))[:-1], _ring(t, 1.0)]))
+    assert _degrees(net) == [1, 3] and net.number_of_edges == 2
+    assert net.report["t_junctions"] == 1
+    loop = next(e for e in net.edges if e.u == e.v)
+    assert arc_length(loop.curve) == pytest.approx(2 * np.pi, rel=0.02)
+
+
 @pytest.mark.parametrize("turns,pitch", [(2, 0.6), (3, 0.4)])
 def test_spiral_stays_as_drawn(turns, pitch):
     """A planar spiral of 2 or 3 turns whose turns lie 0.6 or 0.4 TOL apart (side by side
@@ -125,11 +141,13 @@ def test_spiral_stays_as_drawn(turns, pitch):
     assert arc_length(net.edges[0].curve) == pytest.approx(arc_length(spiral), rel=0.01)
 
 
-def test_hook_turning_away_stays_as_drawn():
+def test_hook_turning_away_is_a_loop_and_its_tail():
     """A ring run 2.5 TOL past its start, 0.4 TOL beside it, that then turns 70 degrees
     away from the circle for 2 TOL: its end is far from its beginning, so it is no loop
-    drawn past its start and stays one open curve running past its start (the hook is
-    trimmed at its corner as any end flick under ``trim`` TOL is)."""
+    drawn past its start (nothing is averaged). Its start lies on the run past it, as
+    a stroke's end on another's interior: a T-junction there closes a loop of one lap,
+    and the run past it with the hook is a dangling tail (before: one open curve, which
+    bounded no face)."""
     d = 0.4 * TOL
     t = np.linspace(0.0, 2 * np.pi + 2.5 * TOL, 600)
     r = 1 - d * _smoothstep((t - (2 * np.pi - 3 * TOL)) / (3 * TOL))
@@ -139,11 +157,12 @@ def test_hook_turning_away_stays_as_drawn():
     out = np.array([np.cos(t[-1]), np.sin(t[-1]), 0.0])
     a = np.radians(70)
     hook = ring[-1] + np.linspace(0, 2 * TOL, 20)[1:, None] * (np.cos(a) * tan + np.sin(a) * out)
-    stroke = np.vstack([ring, hook])
-    net = _snap(stroke)
-    assert (net.number_of_vertices, net.number_of_edges) == (2, 1)
+    net = _snap(np.vstack([ring, hook]))
+    assert _degrees(net) == [1, 3] and net.number_of_edges == 2
     assert net.report["overdrawn_loops"] == 0 and net.report["closed_strokes"] == 0
-    assert arc_length(net.edges[0].curve) == pytest.approx(arc_length(ring), rel=0.01)
+    assert net.report["t_junctions"] == 1
+    loop = next(e for e in net.edges if e.u == e.v)
+    assert arc_length(loop.curve) == pytest.approx(2 * np.pi, rel=0.02)
 
 
 def test_auto_tolerance_joins_a_loop_end_to_its_own_beginning():
