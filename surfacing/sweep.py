@@ -29,12 +29,12 @@ patch is reproduced from its boundary alone.
 Notes
 -----
 Why the own parts are not scaled: a stroke's wobble has the same size on a small
-profile as on a large one. Carried as part of the small profile's shape and scaled up
-with it (the first version: each profile carried whole by ``M^u`` and blended), it grew
-in proportion between them: the inner ring of a torus, a third of the outer one, put
-its wobble into the patch up to three times larger. Split off and carried at its own
-size, it stays within the profiles' own deviation; profiles related by a similarity
-have no own part and are carried exactly as before.
+profile as on a large one. Carried as part of the small profile's shape (each profile
+carried whole by ``M^u`` and blended), it would grow with the profile on its way to the
+large one: the inner ring of a fat torus would put its wobble into the patch magnified
+by the ratio of the rings. Split off and carried at its own size, it stays within the
+profiles' own deviation; profiles related by a similarity have no own part and are
+carried exactly.
 
 Not in Orbay & Kara 2011, whose control mesh is sampled from the Coons patch: the
 swept grid is the *rest shape* of the ``sweep`` fit (:func:`surfacing.fit.fit_lsq`'s
@@ -208,11 +208,13 @@ def transport(A, B, rail0, rail1) -> np.ndarray:
     angle = _turn_with_the_rails(A, axis, angle, rail0, rail1, u)[..., None]  # (..., 1)
     a = A - A.mean(axis=-2, keepdims=True)
     b = B - B.mean(axis=-2, keepdims=True)
-    # the common shape, each profile's own part left absolute (see the module's notes)
+    # the common shape, each profile's own part left absolute (see the module's notes),
+    # under the turn the rails chose (R itself, or none: then B is still reached at u = 1)
+    turn = rotations(axis, angle)[..., 0, :, :]
     sc = s[..., None, None]
-    common = (a + sc * np.einsum("...ji,...mj->...mi", R, b)) / (1.0 + sc * sc)
+    common = (a + sc * np.einsum("...ji,...mj->...mi", turn, b)) / (1.0 + sc * sc)
     own_a = a - common
-    own_b = b - sc * np.einsum("...ij,...mj->...mi", R, common)
+    own_b = b - sc * np.einsum("...ij,...mj->...mi", turn, common)
     fwd = rotations(axis, u * angle)                                       # (..., n, 3, 3)
     w = u[:, None, None]
     X = (s[..., None, None, None] ** w * np.einsum("...kij,...mj->...kmi", fwd, common)

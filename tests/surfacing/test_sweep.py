@@ -133,6 +133,19 @@ def test_degenerate_profiles_give_finite_patches():
     assert np.abs(g[2, :, 2]).max() < 0.3                      # blended through, not turned out
 
 
+def test_a_crest_that_becomes_a_trough_is_blended_all_the_way():
+    """Profiles a half turn apart about their chord with straight rails: the rails say
+    they did not turn, and the rows pass from the crest to the trough evenly, the one
+    before the last next to the trough (not the crest carried unturned and then the
+    trough at the last row)."""
+    a = np.linspace(0, np.pi, 7)
+    bump = np.stack([0 * a, -np.cos(a), 0.3 * np.sin(a)], 1)
+    dip = bump * [1, 1, -1] + [1, 0, 0]
+    x = np.linspace(0, 1, 9)[:, None]
+    out = transport(bump, dip, bump[0] + x * [1, 0, 0], bump[-1] + x * [1, 0, 0])
+    assert np.allclose(out[:, 3, 2], np.linspace(0.3, -0.3, 9), atol=1e-12)
+
+
 def test_a_batch_of_patches_is_each_patch_alone():
     rng = np.random.default_rng(7)
     sides = []
