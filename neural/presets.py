@@ -44,9 +44,9 @@ the splats' Monte-Carlo lumps and lies off rough strokes, which the fields' extr
 training does not take away. Ripples shorter than about 16 % of the padded box's side
 are removed (20 cells at ``default``, 10 at ``draft``), and the strokes are held to
 within half the stroke-fidelity tolerance (``attach_band``). A short cutoff with the
-pull alone (6 cells, before) left the surfaces several times rougher by the
-local-quadric measure and further from the classical surfaces; a long cutoff with the
-pull alone let the surface sag off its strokes (figures: ``benchmarks/README.md``).
+pull alone (6 cells) leaves the surfaces several times rougher by the local-quadric
+measure and further from the classical surfaces; a long cutoff with the pull alone lets
+the surface sag off its strokes (figures: ``benchmarks/README.md``).
 
 Crease presets: ``draft`` for a CPU, ``default`` a 4 x 256 MLP trained 3,000 steps,
 ``paper`` the network size and the 15,000 steps of the paper's 3D examples (Sec. 5),

@@ -208,14 +208,14 @@ def transport(A, B, rail0, rail1) -> np.ndarray:
     angle = _turn_with_the_rails(A, axis, angle, rail0, rail1, u)[..., None]  # (..., 1)
     a = A - A.mean(axis=-2, keepdims=True)
     b = B - B.mean(axis=-2, keepdims=True)
+    fwd = rotations(axis, u * angle)                                       # (..., n, 3, 3)
     # the common shape, each profile's own part left absolute (see the module's notes),
     # under the turn the rails chose (R itself, or none: then B is still reached at u = 1)
-    turn = rotations(axis, angle)[..., 0, :, :]
+    turn = fwd[..., -1, :, :]
     sc = s[..., None, None]
     common = (a + sc * np.einsum("...ji,...mj->...mi", turn, b)) / (1.0 + sc * sc)
     own_a = a - common
     own_b = b - sc * np.einsum("...ij,...mj->...mi", turn, common)
-    fwd = rotations(axis, u * angle)                                       # (..., n, 3, 3)
     w = u[:, None, None]
     X = (s[..., None, None, None] ** w * np.einsum("...kij,...mj->...kmi", fwd, common)
          + (1.0 - w) * np.einsum("...kij,...mj->...kmi", fwd, own_a)

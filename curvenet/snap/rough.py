@@ -207,34 +207,32 @@ def _candidates(st, samples, con, tol, h, opts):
     end_b = (sb <= 0.5 * h) | (sb >= flat.L[b] - 0.5 * h)
     pos = np.where((end_a & ~end_b)[:, None], pb,
                    np.where((end_b & ~end_a)[:, None], pa, 0.5 * (pa + pb)))
-    own = _own_touches(samples, tol, h, opts.overdraw_length * tol, opts.trim * tol)
-    pos = np.vstack([pos, own[0]])
-    mk0 = np.concatenate([np.stack([a, b], axis=1), own[1]])
-    ms0 = np.concatenate([np.stack([sa, sb], axis=1), own[2]])
     closed = [k for k in range(len(st))  # closed strokes: the two ends meet
               if st.length(k) > 4.0 * tol and np.linalg.norm(st.polys[k][0] - st.polys[k][-1])
               <= tol]
+    own = _own_touches(samples, tol, h, closed, opts.overdraw_length * tol, opts.trim * tol)
     ends = np.array([[st.polys[k][0], st.polys[k][-1]] for k in closed]).reshape(-1, 2, 3)
-    pos = np.vstack([pos, 0.5 * (ends[:, 0] + ends[:, 1])])
-    mk = np.concatenate([mk0, np.repeat(closed, 2).reshape(-1, 2)])
-    ms = np.concatenate([ms0, np.array([[0.0, st.length(k)] for k in closed]).reshape(-1, 2)])
+    pos = np.vstack([pos, own[0], 0.5 * (ends[:, 0] + ends[:, 1])])
+    mk = np.concatenate([np.stack([a, b], axis=1), own[1], np.repeat(closed, 2).reshape(-1, 2)])
+    ms = np.concatenate([np.stack([sa, sb], axis=1), own[2],
+                         np.array([[0.0, st.length(k)] for k in closed]).reshape(-1, 2)])
     return pos, mk.astype(np.int64), ms.astype(np.float64), len(closed)
 
 
-def _own_touches(samples, tol, h, run, margin):
+def _own_touches(samples, tol, h, closed, run, margin):
     """T-junctions of a stroke's end on its own interior (a ruling drawn on round its
     ring in one stroke: a "P").
 
-    An end of a stroke that is not closed touches its own stroke where a sample farther
-    than ``2 pi tol`` from it along the stroke (a loop narrower than ``2 tol`` is a curl
-    of the pen, not a face) and more than ``margin`` (``trim * tol``) from the other end
-    lies within ``tol`` of it (nearer, the rest would be trimmed as an overshoot: a ring
-    nearly closed). Only one end may touch: a stroke whose two ends both touch it (a
-    ring whose run past its start crosses its beginning, an "alpha") stays as drawn; so
-    does one whose last ``run`` (``overdraw_length * tol``) runs along that interior
-    within ``tol`` all the way (drawn back over itself: a spiral's turns side by side, a
-    fold). The junction lands on the interior, as a T-junction lands on the through
-    stroke.
+    An end of a stroke that is not ``closed`` (the ids of the closed-stroke rule)
+    touches its own stroke where a sample farther than ``2 pi tol`` from it along the
+    stroke (a loop narrower than ``2 tol`` is a curl of the pen, not a face) and more
+    than ``margin`` (``trim * tol``) from the other end lies within ``tol`` of it
+    (nearer, the rest would be trimmed as an overshoot: a ring nearly closed). Only one
+    end may touch: a stroke whose two ends both touch it (a ring whose run past its
+    start crosses its beginning, an "alpha") stays as drawn; so does one whose last
+    ``run`` (``overdraw_length * tol``) runs along that interior within ``tol`` all the
+    way (drawn back over itself: a spiral's turns side by side, a fold). The junction
+    lands on the interior, as a T-junction lands on the through stroke.
 
     Returns
     -------
@@ -243,9 +241,7 @@ def _own_touches(samples, tol, h, run, margin):
     """
     Q, sid, ss, _, start, flat = samples
     none = (np.zeros((0, 3)), np.zeros((0, 2), np.int64), np.zeros((0, 2)))
-    k = np.flatnonzero(flat.L > 4.0 * tol)
-    k = k[np.linalg.norm(flat.interp(k, np.zeros(len(k))) - flat.interp(k, flat.L[k]), axis=1)
-          > tol]                                                  # closed strokes: their rule
+    k = np.setdiff1d(np.flatnonzero(flat.L > 4.0 * tol), closed)
     if len(k) == 0:
         return none
     k2 = np.repeat(k, 2)
