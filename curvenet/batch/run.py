@@ -388,7 +388,10 @@ class DaskExecutor:
                 fut = client.submit(surface_task, path, data, options, **render,
                                     pure=False, resources=resources)
                 futures[fut] = i
-            for fut in as_completed(futures):
+            # the client's own loop: as_completed would otherwise take the process's
+            # default client, which need not be this one (a notebook's, a test's), and a
+            # result re-run after a lost worker would wait on an event of another loop
+            for fut in as_completed(futures, loop=client.loop):
                 try:
                     row = fut.result()
                 except Exception as err:  # KilledWorker, a lost connection ...
