@@ -95,6 +95,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from curvenet.core.geometry import bbox_diagonal
 from curvenet.core.result import MeshResult
 from curvenet.core.strokes import check_strokes
 from curvenet.core.tolerances import NORM_EPS
@@ -295,8 +296,7 @@ def _attached(V, F, strokes, h_world, cfg: FlowConfig, before: float | None = No
     holds at least as much of them; ``(V, {"fidelity": [before, after], "kept": bool,
     "samples", "pulled", "held"})``. ``before``: the stroke fidelity of ``(V, F)`` when known."""
     from .attach import attach_to_strokes
-    pts = np.concatenate(strokes)
-    band = cfg.attach_band * float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
+    band = cfg.attach_band * bbox_diagonal(list(strokes))
     X, rep = attach_to_strokes(V, F, strokes, h_world, cutoff=cfg.attach,
                                weight=cfg.attach_weight, band=band)
     if before is None:

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from curvenet.core.geometry import fit_plane
+from curvenet.core.geometry import bbox_diagonal, fit_plane
 from curvenet.core.tolerances import DIVISION_GUARD
 
 __all__ = ["AnalyticSurface", "fit_analytic", "fit_circle", "KINDS", "ANALYTIC_TOL",
@@ -225,7 +225,7 @@ def fit_circle(points, *, tol: float = CURVE_TOL):
     p = np.asarray(points, np.float64)
     if len(p) < 3:
         return None
-    ext = float(np.linalg.norm(np.ptp(p, axis=0)))
+    ext = bbox_diagonal(p)
     c, n, _ = fit_plane(p)
     if ext <= 0 or np.abs((p - c) @ n).max() > tol * ext:
         return None
@@ -369,7 +369,7 @@ def _refined(kind, p, guesses, tol):
     first within ``tol``."""
     if not guesses:
         return
-    ext = float(np.linalg.norm(np.ptp(p, axis=0)))
+    ext = bbox_diagonal(p)
     rms = [float(np.sqrt(np.mean(_surface(kind, g).distance(p) ** 2))) for g in guesses]
     order = [i for i in np.argsort(rms)[:REFINED_GUESSES] if rms[i] <= GUESS_SCREEN * ext]
     sub = p[np.linspace(0, len(p) - 1, min(len(p), REFINE_SAMPLES)).astype(int)]
@@ -582,7 +582,7 @@ def _through_singularity(s: AnalyticSurface, p, tol: float, loops=None) -> bool:
     z = (np.asarray(p) - apex) @ s.axis / np.cos(s.minor)   # along the rulings
     if z.min() < -tol and z.max() > tol:
         return True
-    ext = float(np.linalg.norm(np.ptp(p, axis=0)))
+    ext = bbox_diagonal(p)
     if loops is None or np.linalg.norm(p - apex, axis=1).min() <= APEX_AT_BOUNDARY * ext:
         return False
     e1 = s.xdir

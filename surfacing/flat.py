@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from curvenet.core.geometry import fit_plane
+from curvenet.core.geometry import bbox_diagonal, fit_plane
 
 __all__ = ["FLAT_TOL", "flat_planes", "flatten_planar", "mesh_flat", "loop_points",
            "replace_faces"]
@@ -54,8 +54,7 @@ def flat_planes(curves, boundaries, tol: float = FLAT_TOL):
         Unit normals of the fitted planes.
     offsets : (p,) float64
     """
-    allpts = np.concatenate([np.asarray(c, float) for c in curves])
-    diag = float(np.linalg.norm(np.ptp(allpts, axis=0))) or 1.0
+    diag = bbox_diagonal(list(curves)) or 1.0
     normals = np.zeros((len(boundaries), 3))
     offsets = np.zeros(len(boundaries))
     flat = np.zeros(len(boundaries), bool)

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from curvenet.core.geometry import fit_plane
+from curvenet.core.geometry import bbox_diagonal, fit_plane
 
 from .analytic import ANALYTIC_TOL, AnalyticSurface, fit_analytic
 from .api import DEFAULT_EDGE_LENGTH, DEFAULT_MAX_FACES, PatchMeshResult, surface_loops
@@ -263,8 +263,7 @@ def analytic_faces(curves, boundaries, *, tol: float = ANALYTIC_TOL, flat=None, 
         Per patch; None for a free-form boundary.
     """
     curves = [np.asarray(c, np.float64) for c in curves]
-    allpts = np.concatenate(curves)
-    diag = float(np.linalg.norm(np.ptp(allpts, axis=0))) or 1.0
+    diag = bbox_diagonal(curves) or 1.0
     out = []
     for k, b in enumerate(boundaries):
         ids = sorted({c for lp in b for c, _ in lp})
@@ -383,7 +382,7 @@ def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: f
     if analytic_tol is not None:
         surfaces = analytic_faces(curves, boundaries, tol=analytic_tol, flat=flat,
                                   normals=normals, offsets=offsets)
-        diag = float(np.linalg.norm(np.ptp(np.concatenate(curves), axis=0)))
+        diag = bbox_diagonal(list(curves))
         V, F, face_patch, banded = mesh_bands(V, res.faces, face_patch, res.curve_vertices,
                                               curves, boundaries, surfaces,
                                               analytic_tol * diag)

@@ -16,7 +16,7 @@ from scipy.spatial import cKDTree
 
 from .distance import drop_degenerate, load_mesh_arrays, point_surface_distance
 from .errors import InvalidParameterError
-from .geometry import as_polyline, densify_polyline
+from .geometry import as_polyline, bbox_diagonal, densify_polyline
 from .tolerances import DIVISION_GUARD
 
 __all__ = ["STROKE_SPACING_REL", "FIDELITY_TOL_REL", "stroke_list", "stroke_samples",
@@ -59,7 +59,7 @@ def stroke_samples(strokes, spacing):
     lines = [as_polyline(s, name=f"strokes[{i}]") for i, s in enumerate(stroke_list(strokes))]
     if not lines:
         raise InvalidParameterError("strokes: no strokes to measure")
-    diag = float(np.linalg.norm(np.ptp(np.concatenate(lines), axis=0)))
+    diag = bbox_diagonal(lines)
     if not diag > 0:
         raise InvalidParameterError("strokes: the sketch has zero extent")
     dense = [densify_polyline(pl, spacing * diag) for pl in lines]
@@ -116,7 +116,7 @@ def stroke_fidelity(mesh, strokes, *, tol: float = FIDELITY_TOL_REL,
     if not (isinstance(tol, (int, float, np.floating)) and 0 < tol < 1):
         raise InvalidParameterError(f"tol must be a number in (0, 1), got {tol!r}")
     d, _sketch_diag, v, _pts = stroke_sample_distances(mesh, strokes, spacing)
-    diag = float(np.linalg.norm(np.ptp(v, axis=0)))
+    diag = bbox_diagonal(v)
     d = d / max(diag, DIVISION_GUARD)
     return {"fidelity": float(np.mean(d < tol)), "median": float(np.median(d)),
             "p95": float(np.percentile(d, 95)), "diagonal": diag}

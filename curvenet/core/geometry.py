@@ -36,7 +36,29 @@ __all__ = [
     "boundary_edges",
     "sample_surface",
     "fit_plane",
+    "bbox_diagonal",
 ]
+
+
+def bbox_diagonal(points) -> float:
+    """Length of the diagonal of the axis-aligned bounding box of ``points`` ``(n, d)``,
+    or of a list of such arrays (their points together); 0 for no points.
+
+    The unit of the package's relative tolerances (a fraction of "the diagonal").
+
+    Examples
+    --------
+    >>> bbox_diagonal(np.array([[0.0, 0, 0], [3, 4, 0]]))
+    5.0
+    >>> bbox_diagonal([np.zeros((1, 3)), np.array([[0.0, 0, 12]])])
+    12.0
+    """
+    if isinstance(points, (list, tuple)) and points and np.ndim(points[0]) == 2:
+        points = np.concatenate([np.asarray(p, np.float64) for p in points])
+    p = np.asarray(points, np.float64)
+    if p.size == 0:
+        return 0.0
+    return float(np.linalg.norm(p.max(axis=0) - p.min(axis=0)))
 
 
 # --------------------------------------------------------------------------- polylines

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..core.geometry import bbox_diagonal
 from ..model.network import CurveNetwork
 
 __all__ = ["CadPart", "cad_parts", "part_network", "FAMILIES", "EDGE_SAMPLES"]
@@ -391,7 +392,7 @@ def part_network(shape) -> CurveNetwork:
     TopExp.MapShapes_s(shape, TopAbs_EDGE, em)
     pos = np.array([[p.X(), p.Y(), p.Z()] for p in (BRep_Tool.Pnt_s(TopoDS.Vertex(vm.FindKey(i)))
                                                     for i in range(1, vm.Size() + 1))])
-    diag = float(np.linalg.norm(np.ptp(pos, axis=0)))
+    diag = bbox_diagonal(pos)
     net = CurveNetwork(pos)
     for i in range(1, em.Size() + 1):
         e = TopoDS.Edge(TopoDS.Edge(em.FindKey(i)).Oriented(TopAbs_FORWARD))

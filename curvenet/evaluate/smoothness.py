@@ -18,7 +18,7 @@ import numpy as np
 
 from ..core.distance import drop_degenerate, load_mesh_arrays
 from ..core.errors import InvalidParameterError
-from ..core.geometry import sample_surface
+from ..core.geometry import bbox_diagonal, sample_surface
 
 __all__ = ["roughness", "ROUGHNESS_RADIUS"]
 
@@ -63,7 +63,7 @@ def roughness(mesh, *, radius: float = ROUGHNESS_RADIUS, n_centres: int = 4000,
     from scipy.spatial import cKDTree
     V, F = load_mesh_arrays(mesh)
     F, _, areas = drop_degenerate(V, F)
-    diag = float(np.linalg.norm(V.max(axis=0) - V.min(axis=0)))
+    diag = bbox_diagonal(V)
     r = radius * diag
     area = float(areas.sum())
     # a cloud dense enough for about _PER_BALL samples in a flat ball of radius r

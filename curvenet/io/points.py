@@ -51,7 +51,7 @@ from scipy.spatial import cKDTree
 
 from .pointgraph import LINK_R, SPUR, assemble, close_cycles, prune
 from .pointjunctions import junction_point
-from ..core.geometry import cumulative_length, interpolate_polyline
+from ..core.geometry import bbox_diagonal, cumulative_length, interpolate_polyline
 from ..core.tolerances import DIVISION_GUARD
 from ..core.errors import InvalidParameterError, SketchFormatError
 from ..model.sketch import Sketch
@@ -217,7 +217,7 @@ def dimension_profile(points, *, probes: int = 2000, seed: int = 0) -> np.ndarra
         from a quarter of the diagonal until probes have about one neighbour.
     """
     p = np.asarray(points, dtype=np.float64)
-    diag = float(np.linalg.norm(np.ptp(p, axis=0))) or 1.0
+    diag = bbox_diagonal(p) or 1.0
     rng = np.random.default_rng(seed)
     other = p if len(p) <= _PROBES else p[rng.choice(len(p), _PROBES, replace=False)]
     probe = other if len(other) <= probes else other[rng.choice(len(other), probes,
@@ -391,7 +391,7 @@ def recover_curves(points, *, cell: float | None = None, name: str = "points",
     (1, 1, True)
     """
     p = np.asarray(points, dtype=np.float64)
-    diag = float(np.linalg.norm(np.ptp(p, axis=0))) if len(p) else 0.0
+    diag = bbox_diagonal(p)
     if len(p) < MIN_BLOCK_POINTS or diag == 0.0:
         raise NotCurvesError(f"{name}: {len(p)} points spanning {diag:.3g}: too few to "
                              "recover curves from", path=path)

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..core.geometry import arc_length, as_polyline
+from ..core.geometry import arc_length, as_polyline, bbox_diagonal
 from ..core.strokes import LABELS
 from ..core.errors import InvalidParameterError, NetworkError, SketchFormatError
 from .sketch import label_counts
@@ -155,10 +155,7 @@ class CurveNetwork:
     @property
     def diagonal(self) -> float:
         """Bounding-box diagonal of all curve points."""
-        pts = np.concatenate([self.positions] + [e.curve for e in self.edges])
-        if len(pts) == 0:
-            return 0.0
-        return float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
+        return bbox_diagonal([self.positions] + [e.curve for e in self.edges])
 
     # --- serialisation ------------------------------------------------------
     def to_dict(self) -> dict:

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..core.geometry import face_normals_areas
+from ..core.geometry import bbox_diagonal, face_normals_areas
 
 __all__ = ["WALL_WINDING", "CHECK_SAMPLES", "judge_patches", "nonmanifold_curves", "wall_area"]
 
@@ -83,7 +83,7 @@ def judge_patches(vertices, faces, face_patch, patch_edges, n_curves: int, *,
              for k in range(len(patch_edges))]
     sample = np.concatenate(picks)
     owner = np.repeat(np.arange(len(picks)), [len(p) for p in picks])
-    eps = CHECK_OFFSET * float(np.linalg.norm(np.ptp(V, axis=0)))
+    eps = CHECK_OFFSET * bbox_diagonal(V)
     centre = V[F[sample]].mean(axis=1)
     w = igl.fast_winding_number(V, F, np.concatenate([centre + eps * normals[sample],
                                                       centre - eps * normals[sample]]))

@@ -19,10 +19,11 @@ from scipy.spatial import cKDTree
 
 from ..core.distance import point_surface_distance
 from ..core.fidelity import FIDELITY_TOL_REL
-from ..core.geometry import arc_length, boundary_edges, face_normals_areas, sample_surface
+from ..core.geometry import (arc_length, bbox_diagonal, boundary_edges, face_normals_areas,
+                             sample_surface)
 from ..core.result import MeshResult
 from .decision import Region, Route
-from .regions import REGION_GAP, dense, diagonal, plan_regions, region_strokes
+from .regions import REGION_GAP, dense, plan_regions, region_strokes
 from .registry import SurfaceInput, SurfaceSettings, check_option_names, get_surfacer
 
 __all__ = ["patch_anchors", "trim_fill", "close_seam", "fill_seam", "check_hybrid",
@@ -262,7 +263,7 @@ def _fill(fill, options, inp, classical, region, used, gap):
     sub = SurfaceInput(inp.settings, strokes=[curves[i] for i in ids],
                        labels=["boundary"] * len(ids), anchors=anchors)
     res = fill(sub, options)
-    tol = FIDELITY_TOL_REL * diagonal(curves)
+    tol = FIDELITY_TOL_REL * bbox_diagonal(curves)
     keep = trim_fill(res.vertices, res.faces, own, classical.vertices, classical.faces,
                      gap=gap, patch_curves=[curves[i] for i in np.flatnonzero(used)],
                      on_curve=tol / 2)
@@ -327,7 +328,7 @@ def surface_hybrid(inp: SurfaceInput, options: dict) -> MeshResult:
     regions = inp.regions or _plan(curves, inp.loops, inp.holes)
     used = np.zeros(len(curves), bool)
     used[regions[0].curves] = True
-    gap = REGION_GAP * diagonal(curves)
+    gap = REGION_GAP * bbox_diagonal(curves)
     verts, faces = [np.asarray(classical.vertices)], [np.asarray(classical.faces)]
     routes = [np.zeros(len(classical.faces), np.uint8)]
     reports, figures = [], [{} for _ in regions]

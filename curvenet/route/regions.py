@@ -16,11 +16,11 @@ from scipy.sparse import coo_matrix
 from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
-from ..core.geometry import arc_length, densify_polyline
+from ..core.geometry import arc_length, bbox_diagonal, densify_polyline
 from .decision import Region, Route
 
 __all__ = ["REGION_GAP", "FILL_SHARE", "MIN_SPREAD", "MIN_FILL_LENGTH", "plan_regions",
-           "region_strokes", "diagonal", "dense"]
+           "region_strokes", "dense"]
 
 #: curves closer than this fraction of the network's diagonal form one region
 REGION_GAP = 0.08
@@ -35,12 +35,6 @@ FILL_GRID = 16
 #: the network's curve length: a fill costs a whole neural fit, and a smaller region
 #: (a detail beside dozens of patches) is represented as wires instead
 MIN_FILL_LENGTH = 0.1
-
-
-def diagonal(curves) -> float:
-    """Bounding-box diagonal of the points of all ``curves``."""
-    pts = np.concatenate(curves)
-    return float(np.linalg.norm(np.ptp(pts, axis=0)))
 
 
 def dense(curves, step: float) -> np.ndarray:
@@ -115,7 +109,7 @@ def plan_regions(curves, used, *, gap_rel: float = REGION_GAP) -> list:
     ids = [int(i) for i in np.flatnonzero(~np.asarray(used, bool))]
     if not ids:
         return []
-    gap = gap_rel * diagonal(curves)
+    gap = gap_rel * bbox_diagonal(curves)
     lengths = [arc_length(c) for c in curves]
     total = sum(lengths)
     regions = []
@@ -136,7 +130,7 @@ def region_strokes(curves, region: Region, used, *, gap_rel: float = REGION_GAP)
     Patch curves within the region's gap are the constraints through which the fill
     meets the patches (they are data of the fit, like the region's own curves).
     """
-    gap = gap_rel * diagonal(curves)
+    gap = gap_rel * bbox_diagonal(curves)
     own = list(region.curves)
     tree = cKDTree(np.concatenate([densify_polyline(curves[i], gap / 2) for i in own]))
     beside = [int(i) for i in np.flatnonzero(np.asarray(used, bool))

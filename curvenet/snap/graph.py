@@ -115,7 +115,7 @@ from dataclasses import asdict, dataclass, replace
 import numpy as np
 from scipy.spatial import cKDTree
 
-from ..core.geometry import densify_polylines, segment_closest
+from ..core.geometry import bbox_diagonal, densify_polylines, segment_closest
 from ..core.tolerances import (COINCIDENT_REL, DEFAULT_SNAP_TOL, DIVISION_GUARD,
                                DUPLICATE_POINT_REL, check_snap_tol)
 from ..core.errors import InvalidParameterError
@@ -216,8 +216,7 @@ def _prepare(sketch, opts):
     use = [i for i, lab in enumerate(sketch.labels) if lab != "construction"]
     if not use:
         raise InvalidParameterError("sketch has no boundary or crease strokes to snap")
-    pts = np.concatenate([sketch.strokes[i] for i in use])
-    diag = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0)))
+    diag = bbox_diagonal([sketch.strokes[i] for i in use])
     if not diag > 0:
         raise InvalidParameterError("sketch has zero extent (all points coincide)")
     strokes, src, labels = [], [], []

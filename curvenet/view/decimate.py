@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.geometry import bbox_diagonal
 from ..core.tolerances import COINCIDENT_REL
 
 __all__ = ["decimate_clustering"]
@@ -45,7 +46,7 @@ def decimate_clustering(vertices, faces, max_faces: int, *, return_index: bool =
     area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]),
                                 axis=1).sum()
     lo = v.min(axis=0)
-    diag = float(np.linalg.norm(np.ptp(v, axis=0)))
+    diag = bbox_diagonal(v)
     h = max(np.sqrt(2.0 * area / max_faces), COINCIDENT_REL * diag)
     for _ in range(20):
         keys = np.floor((v - lo) / h).astype(np.int64)  # (V, 3)
