@@ -94,11 +94,20 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
     """
     import igl
 
+    from curvenet.core.distance import drop_degenerate
     from curvenet.core.geometry import densify_polyline
     V = np.asarray(V, np.float64)
-    F = np.asarray(F, np.int64)
-    L = igl.cotmatrix(V, F)
-    m = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal()
+    # marching cubes leaves a few zero-area triangles, whose cotangents are not finite:
+    # the energy is taken over the others (a vertex of none keeps its place)
+    F = drop_degenerate(V, np.asarray(F, np.int64))[0]
+    if not len(F):
+        return V.copy(), {"samples": 0, "pulled": 0, "held": 0}
+    n = len(V)
+    L = sp.csr_matrix(igl.cotmatrix(V, F))
+    L.resize((n, n))              # libigl sizes both by the last vertex that faces use
+    m = np.zeros(n)
+    md = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal()
+    m[:len(md)] = md
     m = np.maximum(m, 1e-12 * m.max())
     alpha = (2.0 * np.pi / (cutoff * h)) ** 4
     S = np.concatenate([densify_polyline(np.asarray(s, np.float64), h) for s in strokes])

@@ -65,3 +65,15 @@ def test_a_band_holds_the_strokes_that_a_weak_pull_lets_the_surface_sag_off():
     # held as a band, not onto every sample: the strokes' noise does not come back
     assert roughness((X, F))["median"] < 1.5 * roughness((loose, F))["median"]
     assert roughness((X, F))["median"] < 0.1 * roughness((V, F))["median"]
+
+
+def test_zero_area_triangles_of_marching_cubes_do_not_break_the_solve():
+    V, F = _bumpy_sphere()
+    # a vertex doubled and a triangle of zero area on it (as marching cubes leaves them)
+    V = np.vstack([V, V[F[0, 0]]])
+    F = np.vstack([F, [F[0, 0], len(V) - 1, F[0, 1]], [F[0, 0], F[0, 0], F[0, 2]]])
+    t = np.linspace(0, 2 * np.pi, 400)
+    strokes = [np.c_[np.cos(t), np.sin(t), 0 * t]]
+    X, rep = attach_to_strokes(V, F, strokes, 0.05, cutoff=20.0, weight=100.0, band=0.017)
+    assert np.isfinite(X).all() and rep["pulled"] == rep["samples"] > 0
+    assert stroke_fidelity((X, F), strokes)["fidelity"] > 0.95
