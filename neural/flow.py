@@ -298,7 +298,7 @@ def _attached(V, F, strokes, h_world, cfg: FlowConfig, before: float | None = No
     from .attach import attach_to_strokes
     band = cfg.attach_band * bbox_diagonal(list(strokes))
     X, rep = attach_to_strokes(V, F, strokes, h_world, cutoff=cfg.attach,
-                               weight=cfg.attach_weight, band=band)
+                               weight=cfg.attach_weight, band=band, reach=cfg.attach_reach)
     if before is None:
         before = _fidelity(V, F, strokes)
     fidelity = [before, _fidelity(X, F, strokes)]

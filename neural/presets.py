@@ -42,8 +42,9 @@ from the paper in:
 Both also fair the extracted mesh onto the strokes (``attach``): the zero set carries
 the splats' Monte-Carlo lumps and lies off rough strokes, which the fields' extra
 training does not take away. Ripples shorter than about 16 % of the padded box's side
-are removed (20 cells at ``default``, 10 at ``draft``), and the strokes are held to
-within half the stroke-fidelity tolerance (``attach_band``). A short cutoff with the
+are removed (20 cells at ``default``, 10 at ``draft``), and the strokes within about 5 %
+of the box's side (``attach_reach``: 6 cells, 3) are held to within half the
+stroke-fidelity tolerance (``attach_band``). A short cutoff with the
 pull alone (6 cells) leaves the surfaces several times rougher by the local-quadric
 measure and further from the classical surfaces; a long cutoff with the pull alone lets
 the surface sag off its strokes (figures: ``benchmarks/README.md``).
@@ -160,6 +161,10 @@ class FlowConfig:
         In that fairing, the stroke samples left farther than this fraction of the
         strokes' bounding-box diagonal from the surface are held to it (0 = the pull
         alone); half the stroke-fidelity tolerance in ``draft`` and ``default``.
+    attach_reach : float
+        In that fairing, the stroke samples farther than this many grid cells from the
+        extracted surface are left out (not pulled). The same share of the padded box
+        in ``draft`` (3 of 64 cells) and ``default`` (6 of 128), as the cutoff is.
     """
 
     res: int = 128
@@ -194,6 +199,7 @@ class FlowConfig:
     attach: float = 0.0
     attach_weight: float = 100.0
     attach_band: float = 0.0
+    attach_reach: float = 3.0
 
     def as_dict(self) -> dict:
         """The settings as a plain dict (for reports)."""
@@ -206,7 +212,7 @@ PRESETS: dict[str, FlowConfig] = {
                         w_smooth=0.1, attach=10.0, attach_band=0.005),
     "default": FlowConfig(steps=140, w_smooth=0.1, polish=4, polish_rounds=4,
                           polish_strip=1.0, average_from=0.6, attach=20.0,
-                          attach_band=0.005),
+                          attach_band=0.005, attach_reach=6.0),
     "paper": FlowConfig(res=256, width=256, hidden_layers=4, n_stroke=10000, n_surface=15000,
                         n_volume=15000, init_steps=200, steps=800, lr=5e-5,
                         geometric_init_steps=0),

@@ -67,6 +67,26 @@ def test_a_band_holds_the_strokes_that_a_weak_pull_lets_the_surface_sag_off():
     assert roughness((X, F))["median"] < 0.1 * roughness((V, F))["median"]
 
 
+def test_the_reach_decides_which_strokes_pull_and_is_the_same_share_of_the_box_in_the_presets():
+    from curvenet.neural.presets import get_config
+    V, F = _bumpy_sphere()
+    V = V * (0.80 / 0.96)                             # shrunk 20%: strokes 4 cells off
+    t = np.linspace(0, 2 * np.pi, 400)
+    strokes = [np.c_[np.cos(t), np.sin(t), 0 * t], np.c_[np.cos(t), 0 * t, np.sin(t)]]
+    h, band = 0.05, 0.005 * np.sqrt(12.0)
+    fid = {}
+    for reach in (3.0, 6.0):
+        X, rep = attach_to_strokes(V, F, strokes, h, cutoff=20.0, weight=100.0, band=band,
+                                   reach=reach)
+        assert (rep["pulled"] == 0) == (reach == 3.0)
+        fid[reach] = stroke_fidelity((X, F), strokes)["fidelity"]
+    assert fid[3.0] < 0.05 and fid[6.0] > 0.95
+    # the reach is a share of the padded box, like the cutoff: the same at draft and default
+    draft, default = get_config("draft"), get_config("default")
+    assert draft.attach_reach / draft.res == default.attach_reach / default.res
+    assert draft.attach / draft.res == default.attach / default.res
+
+
 def test_zero_area_triangles_of_marching_cubes_do_not_break_the_solve():
     V, F = _bumpy_sphere()
     # a vertex doubled and a triangle of zero area on it (as marching cubes leaves them)
