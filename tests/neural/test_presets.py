@@ -26,7 +26,8 @@ def test_overrides_and_presets():
                                       ({"normalize_from": 2.0}, "normalize_from"),
                                       ({"average_from": -0.1}, "average_from"),
                                       ({"dtype": "float16"}, "dtype"),
-                                      ({"polish": 1.5}, "polish")])
+                                      ({"polish": 1.5}, "polish"),
+                                      ({"attach_reach": -1.0}, "attach_reach")])
 def test_bad_overrides(kw, match):
     with pytest.raises(ValueError, match=match):
         get_config("draft", **kw)
