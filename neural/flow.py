@@ -75,6 +75,11 @@ Engineering choices (documented deviations / gap fills)
   whose zero set was extracted. Not with ``anchors``: a fill beside classical patches
   must meet their surface, which the fairing does not see (the hybrid route closes
   that seam itself).
+* ``subdivide`` (draft, default): the final mesh is subdivided once, its new vertices
+  on the curved point-normal triangles of the old ones
+  (:func:`curvenet.core.geometry.subdivide_curved`): the facets of a mesh extracted
+  at the grid's cell size are flat where the surface is curved. Not with ``anchors``
+  (a fill's border is trimmed against the patches beside it).
 * ``anchors`` (not in the paper): oriented points of another surface the fit must
   meet (a hybrid fill beside classical patches). Each step draws
   ``min(m, n_stroke)`` of them; they join the stroke samples in the data term
@@ -95,7 +100,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from curvenet.core.geometry import bbox_diagonal
+from curvenet.core.geometry import bbox_diagonal, subdivide_curved
 from curvenet.core.result import MeshResult
 from curvenet.core.strokes import check_strokes
 from curvenet.core.tolerances import NORM_EPS
@@ -259,6 +264,9 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
         # the polish measured the fidelity of the mesh it returned
         before = None if polish is None else polish["fidelity"][int(polish["kept"])]
         V, attach = _attached(V, F, strokes, h_world, cfg, before)
+    if anchors is None:
+        for _ in range(int(cfg.subdivide) if len(F) else 0):
+            V, F = subdivide_curved(V, F)
     timings["extract"] = time.perf_counter() - t0
     timings["total"] = time.perf_counter() - t_start
     report = {"steps": steps_done, "interrupted": interrupted, "device": str(dev), "seed": seed,

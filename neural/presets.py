@@ -165,6 +165,13 @@ class FlowConfig:
         In that fairing, the stroke samples farther than this many grid cells from the
         extracted surface are left out (not pulled). The same share of the padded box
         in ``draft`` (3 of 64 cells) and ``default`` (6 of 128), as the cutoff is.
+    subdivide : int
+        Rounds (at most :data:`MAX_SUBDIVIDE`) of curved 1-to-4 subdivision of the final
+        mesh (:func:`curvenet.core.geometry.subdivide_curved`): the new vertices on the
+        point-normal triangles of the old ones, which takes the facets of a grid-cell
+        sized mesh off the surface's curvature (4 times the triangles a round). One round
+        in ``draft`` and ``default``; none in ``paper`` (its 256^3 grid). Not with
+        ``anchors``. Not in the paper.
     """
 
     res: int = 128
@@ -200,6 +207,7 @@ class FlowConfig:
     attach_weight: float = 100.0
     attach_band: float = 0.0
     attach_reach: float = 3.0
+    subdivide: int = 0
 
     def as_dict(self) -> dict:
         """The settings as a plain dict (for reports)."""
@@ -209,10 +217,10 @@ class FlowConfig:
 PRESETS: dict[str, FlowConfig] = {
     "draft": FlowConfig(res=64, width=64, hidden_layers=2, n_stroke=1200, n_surface=1000,
                         n_volume=600, init_steps=40, steps=100, lr=3e-4, poisson_every=1,
-                        w_smooth=0.1, attach=10.0, attach_band=0.005),
+                        w_smooth=0.1, attach=10.0, attach_band=0.005, subdivide=1),
     "default": FlowConfig(steps=140, w_smooth=0.1, polish=4, polish_rounds=4,
                           polish_strip=1.0, average_from=0.6, attach=20.0,
-                          attach_band=0.005, attach_reach=6.0),
+                          attach_band=0.005, attach_reach=6.0, subdivide=1),
     "paper": FlowConfig(res=256, width=256, hidden_layers=4, n_stroke=10000, n_surface=15000,
                         n_volume=15000, init_steps=200, steps=800, lr=5e-5,
                         geometric_init_steps=0),
@@ -267,6 +275,9 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
         v = getattr(cfg, name)
         if int(v) != v or v < 0:
             raise ValueError(f"{name} must be a non-negative integer, got {v!r}")
+    if int(cfg.subdivide) != cfg.subdivide or not 0 <= cfg.subdivide <= MAX_SUBDIVIDE:
+        raise ValueError(f"subdivide must be an integer in [0, {MAX_SUBDIVIDE}], "
+                         f"got {cfg.subdivide!r}")
     if cfg.res < 8:
         raise ValueError(f"res must be at least 8, got {cfg.res}")
     if cfg.res > MAX_RES:
@@ -289,6 +300,8 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
     return cfg
 
 
+#: Most rounds of the final mesh's subdivision (each quadruples the triangles).
+MAX_SUBDIVIDE = 2
 #: Largest Poisson grid accepted (``res``); larger grids are refused before any allocation.
 MAX_RES = 512
 #: Rough bytes per grid voxel of a fit (float32 field, FFT buffers, splats), for the message.

@@ -223,3 +223,39 @@ def test_segment_closest_points_match_brute_force():
 
 
 # --------------------------------------------------------------------------- invariants
+
+
+# --------------------------------------------------------------------------- subdivision
+def test_curved_subdivision_puts_new_vertices_near_the_sphere_and_keeps_the_topology():
+    import trimesh
+
+    from curvenet.core.geometry import subdivide_curved
+    m = trimesh.creation.icosphere(2)                 # vertices on the unit sphere
+    V, F = subdivide_curved(m.vertices, m.faces)
+    assert V.shape == (len(m.vertices) + len(m.edges_unique), 3) and F.shape == (4 * len(m.faces), 3)
+    np.testing.assert_array_equal(V[:len(m.vertices)], m.vertices)
+    curved = np.abs(np.linalg.norm(V[len(m.vertices):], axis=1) - 1.0).max()
+    e = m.vertices[m.edges_unique]
+    flat = np.abs(np.linalg.norm(e.mean(axis=1), axis=1) - 1.0).max()
+    assert curved < flat / 8                          # the chord error an order smaller
+    out = trimesh.Trimesh(V, F, process=False)
+    assert out.is_watertight and out.is_winding_consistent
+    assert out.euler_number == m.euler_number == 2
+    assert out.volume > m.volume > 0                  # outward kept, nearer the ball's 4 pi / 3
+    assert out.volume < 4 * np.pi / 3
+
+
+def test_curved_subdivision_keeps_a_flat_open_mesh_flat():
+    from curvenet.core.geometry import subdivide_curved
+    g = np.stack(np.meshgrid(np.arange(4.0), np.arange(3.0), indexing="ij"), -1).reshape(-1, 2)
+    V0 = np.c_[g, np.zeros(len(g))]
+    idx = np.arange(12).reshape(4, 3)
+    a, b, c, d = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel(), idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
+    F0 = np.r_[np.c_[a, b, c], np.c_[a, c, d]]
+    V, F = subdivide_curved(V0, F0)
+    assert np.abs(V[:, 2]).max() == 0.0
+    # the new vertices are the edges' midpoints (normals all equal: no correction)
+    edges = np.unique(np.sort(F0[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1), axis=0)
+    mids = V0[edges].mean(axis=1)
+    np.testing.assert_allclose(np.unique(V[12:], axis=0), np.unique(mids, axis=0), atol=1e-12)
+    assert len(F) == 4 * len(F0)

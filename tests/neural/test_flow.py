@@ -383,3 +383,18 @@ def test_surface_samples_come_from_exactly_the_sign_change_cells():
     assert torch.equal(_in_some_cell(f > 0) & _in_some_cell(f < 0), want)
     p = sample_surface_cells(f, 500, torch.Generator().manual_seed(1))
     assert p.shape == (500, 3) and float(interpolate(f, p).abs().max()) < 0.5 / n
+
+
+def test_subdivide_curves_the_final_mesh_of_the_same_fit():
+    import trimesh
+    strokes = _circles()
+    flat = fit_flow_surface(strokes, progress=False, seed=0, **TINY, subdivide=0)
+    curved = fit_flow_surface(strokes, progress=False, seed=0, **TINY, subdivide=1)
+    assert len(flat.faces) and len(curved.faces) == 4 * len(flat.faces)
+    np.testing.assert_allclose(curved.vertices[:len(flat.vertices)], flat.vertices)
+    a = trimesh.Trimesh(flat.vertices, flat.faces, process=False)
+    b = trimesh.Trimesh(curved.vertices, curved.faces, process=False)
+    assert b.euler_number == a.euler_number and b.is_watertight == a.is_watertight
+    # the new vertices bulge out of the flat facets of a round surface: a larger volume
+    assert abs(b.volume) > abs(a.volume)
+    assert curved.report["n_faces"] == len(curved.faces)

@@ -27,7 +27,9 @@ def test_overrides_and_presets():
                                       ({"average_from": -0.1}, "average_from"),
                                       ({"dtype": "float16"}, "dtype"),
                                       ({"polish": 1.5}, "polish"),
-                                      ({"attach_reach": -1.0}, "attach_reach")])
+                                      ({"attach_reach": -1.0}, "attach_reach"),
+                                      ({"subdivide": 3}, "subdivide"),
+                                      ({"subdivide": 0.5}, "subdivide")])
 def test_bad_overrides(kw, match):
     with pytest.raises(ValueError, match=match):
         get_config("draft", **kw)
