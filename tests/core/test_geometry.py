@@ -232,7 +232,8 @@ def test_curved_subdivision_puts_new_vertices_near_the_sphere_and_keeps_the_topo
     from curvenet.core.geometry import subdivide_curved
     m = trimesh.creation.icosphere(2)                 # vertices on the unit sphere
     V, F = subdivide_curved(m.vertices, m.faces)
-    assert V.shape == (len(m.vertices) + len(m.edges_unique), 3) and F.shape == (4 * len(m.faces), 3)
+    assert V.shape == (len(m.vertices) + len(m.edges_unique), 3)
+    assert F.shape == (4 * len(m.faces), 3)
     np.testing.assert_array_equal(V[:len(m.vertices)], m.vertices)
     curved = np.abs(np.linalg.norm(V[len(m.vertices):], axis=1) - 1.0).max()
     e = m.vertices[m.edges_unique]
@@ -250,7 +251,8 @@ def test_curved_subdivision_keeps_a_flat_open_mesh_flat():
     g = np.stack(np.meshgrid(np.arange(4.0), np.arange(3.0), indexing="ij"), -1).reshape(-1, 2)
     V0 = np.c_[g, np.zeros(len(g))]
     idx = np.arange(12).reshape(4, 3)
-    a, b, c, d = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel(), idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
+    a, b = idx[:-1, :-1].ravel(), idx[1:, :-1].ravel()
+    c, d = idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()
     F0 = np.r_[np.c_[a, b, c], np.c_[a, c, d]]
     V, F = subdivide_curved(V0, F0)
     assert np.abs(V[:, 2]).max() == 0.0
