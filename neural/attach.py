@@ -2,22 +2,30 @@
 
 Not in the paper. The zero set of the integrated f carries the Monte-Carlo noise of the
 splats as lumps a few grid cells wide, and sits off rough strokes where the field's
-smoothing pulled it in between them. :func:`attach_to_strokes` moves the mesh vertices
-``X`` to the minimiser of
+smoothing pulled it in between them. :func:`attach_to_strokes` takes the lumps out and
+the surface onto its strokes in two steps, each a linear low-pass with ``L`` the
+cotangent Laplacian and ``M`` the Voronoi mass matrix of the extracted mesh ``V``
+(libigl):
 
-    ``|L X|^2_{M^-1} + alpha |X - V|^2_M + sum_s beta_s |B_s X - t_s|^2``
+1. the shape: ``Y`` minimises ``|L Y|^2_{M^-1} + alpha |Y - V|^2_M``, whose response to
+   a ripple of wavenumber ``k`` is ``1 / (1 + k^4 / alpha)``; ``alpha = (2 pi / (cutoff
+   h))^4`` removes ripples shorter than ``cutoff`` cells ``h`` and keeps the shape at
+   larger scales without the shrinking of Laplacian smoothing;
+2. the way onto the strokes: ``X = Y + D`` minimises ``|L D|^2_{M^-1} + alpha_2 |D|^2_M
+   + sum_s beta_s |B_s X - t_s|^2``, with ``B_s`` the barycentric row of the closest
+   surface point of each stroke sample ``s`` within ``reach`` grid cells of ``V`` and
+   ``alpha_2`` the same low-pass at :data:`SPREAD` times the cutoff: the displacement
+   that brings the surface onto its strokes is smoother than the shape itself.
 
-with ``L`` the cotangent Laplacian and ``M`` the Voronoi mass matrix of the extracted
-mesh ``V`` (libigl), ``B_s`` the barycentric row of the closest surface point of each
-stroke sample ``s`` within ``reach`` grid cells: a linear low-pass of the surface (its
-response to a ripple of wavenumber ``k`` is ``1 / (1 + k^4 / alpha)``, so
-``alpha = (2 pi / (cutoff h))^4`` removes ripples shorter than ``cutoff`` cells ``h``
-and keeps the shape at larger scales without the shrinking of Laplacian smoothing)
-that also pulls the surface onto the strokes near it.
+Done in one step (the pull added to the first energy, as this module first did), the
+pull of each stroke sample dents the surface within the first low-pass's reach, about
+``cutoff / 2 pi`` cells, the size of the ball the roughness measure fits a quadric in:
+a seam of small dents along every stroke. Spread over twice the cutoff, the same pull
+bends the surface over a wider area and leaves no dent.
 
-Every sample first pulls with ``beta = weight alpha h^2`` (a stroke sample every cell
-weighs ``weight`` times a vertex's area term) towards itself (``t_s = s``). The weaker
-the low-pass's data term (the longer the cutoff), the weaker that pull: a low-pass long
+Every sample first pulls with ``beta = weight alpha_2 h^2`` (a stroke sample every cell
+weighs ``weight`` times a vertex's area term of step 2) towards itself (``t_s = s``). The
+weaker that data term (the longer the cutoff), the weaker the pull: a low-pass long
 enough to take out every lump would also let the surface sag off its strokes. So with
 a ``band``, the samples the solution leaves farther than ``band`` from the surface are
 then held :data:`HELD` times harder, towards the point at ``band`` from them on the
@@ -32,10 +40,12 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 
-__all__ = ["attach_to_strokes", "HELD"]
+__all__ = ["attach_to_strokes", "HELD", "SPREAD"]
 
 #: How much harder a stroke sample outside the band pulls than the others.
 HELD = 1000.0
+#: The displacement onto the strokes is low-passed at this many times the shape's cutoff.
+SPREAD = 2.0
 #: Solves after the first, each holding the samples still outside the band.
 _HOLD_ROUNDS = 2
 
@@ -82,7 +92,7 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
         Distance (model units) within which every pulled sample is held; 0 = no
         holding, the pull ``weight`` alone. Ignored when ``weight`` is 0.
     reach : float
-        Stroke samples farther than this many cells from the surface are left out.
+        Stroke samples farther than this many cells from ``V`` are left out.
 
     Returns
     -------
@@ -109,17 +119,22 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
     md = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal()
     m[:len(md)] = md
     m = np.maximum(m, 1e-12 * m.max())
+    bend = L.T @ sp.diags(1.0 / m) @ L
     alpha = (2.0 * np.pi / (cutoff * h)) ** 4
+    Y = _solve(bend + alpha * sp.diags(m), alpha * (m[:, None] * V))       # step 1: the shape
     S = np.concatenate([densify_polyline(np.asarray(s, np.float64), h) for s in strokes])
-    d2, fi, closest = igl.point_mesh_squared_distance(S, V, F)
+    near = np.sqrt(np.maximum(igl.point_mesh_squared_distance(S, V, F)[0], 0.0)) < reach * h
+    S = S[near]
+    if weight == 0 or not len(S):
+        return Y, {"samples": int(len(near)), "pulled": int(len(S)), "held": 0}
+    d2, fi, closest = igl.point_mesh_squared_distance(S, Y, F)
     dist = np.sqrt(np.maximum(d2, 0.0))
-    near = dist < reach * h
-    S, dist, fi, closest = S[near], dist[near], fi[near], closest[near]
-    K = L.T @ sp.diags(1.0 / m) @ L + alpha * sp.diags(m)
-    base = alpha * (m[:, None] * V)
-    beta = weight * alpha * h * h
-    X, held = V, np.zeros(len(S), bool)
-    for r in range(1 + (_HOLD_ROUNDS if band > 0 and weight > 0 else 0)):
+    alpha2 = (2.0 * np.pi / (SPREAD * cutoff * h)) ** 4                  # step 2: onto the strokes
+    K = bend + alpha2 * sp.diags(m)
+    base = K @ Y                                   # |L (X - Y)|^2 + alpha_2 |X - Y|^2
+    beta = weight * alpha2 * h * h
+    X, held = Y, np.zeros(len(S), bool)
+    for r in range(1 + (_HOLD_ROUNDS if band > 0 else 0)):
         if r:   # the samples the last solve left outside the band join the held ones
             d2, fi, closest = igl.point_mesh_squared_distance(S, X, F)
             dist = np.sqrt(np.maximum(d2, 0.0))
@@ -136,4 +151,4 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
         target = S + frac[:, None] * (closest - S)
         w = np.where(held, HELD * beta, beta)
         X = _solve(K + B.T @ sp.diags(w) @ B, base + B.T @ (w[:, None] * target))
-    return X, {"samples": int(len(near)), "pulled": int(near.sum()), "held": int(held.sum())}
+    return X, {"samples": int(len(near)), "pulled": int(len(S)), "held": int(held.sum())}
