@@ -398,9 +398,9 @@ def subdivide_curved(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarra
     curved one is off by the error of the estimated normals times the edge, of the same
     order in ``e`` with a constant about an order smaller: the facets' chord error drops
     by that much, at four times the triangles. A flat region stays flat. The old
-    vertices stay; each triangle ``(a, b, c)``
-    becomes ``(a, ab, ca), (b, bc, ab), (c, ca, bc), (ab, bc, ca)`` (orientation kept, so
-    a watertight mesh stays watertight with the same Euler characteristic).
+    vertices stay; each triangle ``(a, b, c)`` becomes ``(a, ab, ca), (b, bc, ab),
+    (c, ca, bc), (ab, bc, ca)`` (orientation kept, so a watertight mesh stays watertight
+    with the same Euler characteristic).
 
     Parameters
     ----------
