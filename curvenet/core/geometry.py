@@ -3,9 +3,8 @@
 Polylines: validation, arc length, interpolation at arc-length parameters,
 resampling; triangle meshes: face normals and areas, boundary edges, area-uniform
 random sampling (trimesh's :func:`trimesh.sample.sample_surface`), a curved 1-to-4
-subdivision. Everything takes
-and returns numpy arrays; nothing here imports torch or another curvenet module
-(the neural backend converts the samples to tensors itself).
+subdivision. Everything takes and returns numpy arrays; nothing here imports torch or
+another curvenet module (the neural backend converts the samples to tensors itself).
 
 Notes
 -----
