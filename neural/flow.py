@@ -264,9 +264,8 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
         # the polish measured the fidelity of the mesh it returned
         before = None if polish is None else polish["fidelity"][int(polish["kept"])]
         V, attach = _attached(V, F, strokes, h_world, cfg, before)
-    if anchors is None:
-        for _ in range(int(cfg.subdivide) if len(F) else 0):
-            V, F = subdivide_curved(V, F)
+    for _ in range(int(cfg.subdivide) if anchors is None and len(F) else 0):
+        V, F = subdivide_curved(V, F)
     timings["extract"] = time.perf_counter() - t0
     timings["total"] = time.perf_counter() - t_start
     report = {"steps": steps_done, "interrupted": interrupted, "device": str(dev), "seed": seed,

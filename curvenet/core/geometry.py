@@ -380,10 +380,14 @@ def boundary_edges(faces: np.ndarray) -> np.ndarray:
     >>> boundary_edges(np.array([[0, 1, 2], [2, 1, 3]])).tolist()
     [[0, 1], [0, 2], [1, 3], [2, 3]]
     """
-    f = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
-    edges = np.sort(f[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
-    edges, count = np.unique(edges, axis=0, return_counts=True)
+    edges, count = np.unique(_face_edges(faces), axis=0, return_counts=True)
     return edges[count == 1]
+
+
+def _face_edges(faces) -> np.ndarray:
+    """(3 F, 2) int64: each triangle's edges ``ab, bc, ca`` in turn, the smaller id first."""
+    f = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    return np.sort(f[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
 
 
 def subdivide_curved(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -415,18 +419,18 @@ def subdivide_curved(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarra
     V = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
     tri = V[f]                                                               # (F, 3, 3)
-    unit = face_normals_areas(V, f)[0]
+    unit, area = face_normals_areas(V, f)
     # angle-weighted vertex normals (each face's normal by its angle at the corner): on
-    # the uneven triangles of marching cubes, steadier than area weights
+    # the uneven triangles of marching cubes, steadier than area weights. The sine side
+    # |u x w| is twice the face's area at every corner.
     u = np.roll(tri, -1, axis=1) - tri                                       # corner -> next
     w = np.roll(tri, 1, axis=1) - tri                                        # corner -> previous
-    angle = np.arctan2(np.linalg.norm(np.cross(u, w), axis=2), (u * w).sum(axis=2))
+    angle = np.arctan2(2.0 * area[:, None], (u * w).sum(axis=2))
     contrib = (angle[:, :, None] * unit[:, None, :]).reshape(-1, 3)
     n = np.stack([np.bincount(f.ravel(), contrib[:, k], minlength=len(V)) for k in range(3)],
                  axis=1)
     n /= np.maximum(np.linalg.norm(n, axis=1), DIVISION_GUARD)[:, None]     # unused: zero
-    edges, inverse = np.unique(np.sort(f[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1),
-                               axis=0, return_inverse=True)
+    edges, inverse = np.unique(_face_edges(f), axis=0, return_inverse=True)
     p, q = V[edges[:, 0]], V[edges[:, 1]]
     np_, nq = n[edges[:, 0]], n[edges[:, 1]]
     e = q - p
