@@ -3,10 +3,12 @@
 Run from the repository root::
 
     nice -n 5 python benchmarks/bench_smoothness.py --out smooth.tsv
-        [--sketches vns/torus,cassie/01-0-1] [--quality draft] [--threads 2]
+        [--sketches vns/torus,cassie/01-0-1] [--quality draft] [--threads 2] [--meshes DIR]
 
 Each sketch (default: the 22 of ``$CURVENET_DATA/sketches/vns``, ``input/`` included;
-``--sketches`` takes ``SET/STEM`` names of ``vns`` and ``cassie``) is surfaced twice:
+``--sketches`` takes ``SET/STEM`` names of ``vns``, ``cassie`` and ``networks``, the
+public clean curve networks: ``networks/haopan/loftbug``; a set's name alone takes all
+of it) is surfaced twice:
 ``curvenet.surface(path, method="classical")`` and ``method="neural"`` at ``--quality``.
 One row per sketch (appended as soon as it is done): for each surface the seconds, the
 stroke fidelity of the surface alone (share of stroke length within 1% of the sketch's
@@ -33,7 +35,8 @@ from curvenet.evaluate import evaluate_mesh, roughness, sketch_fidelity
 
 DATA = Path(os.environ.get("CURVENET_DATA",
                            Path(__file__).resolve().parents[1].parent / "shared" / "data"))
-SETS = {"cassie": ("sketches/cassie/curves", ".curves"), "vns": ("sketches/vns", ".obj")}
+SETS = {"cassie": ("sketches/cassie/curves", ".curves"), "networks": ("networks", ".obj"),
+        "vns": ("sketches/vns", ".obj")}
 COLUMNS = ("sketch", "classical_s", "classical_fid", "classical_rough", "classical_rough90",
            "neural_s", "neural_fid", "neural_rough", "neural_rough90", "f1_vs_classical",
            "f2_vs_classical")
@@ -45,13 +48,16 @@ def _measure(res):
     return fid, 1000 * r["median"], 1000 * r["p90"]
 
 
-def _row(name: str, path: Path, quality: str) -> dict:
+def _row(name: str, path: Path, quality: str, meshes: Path | None = None) -> dict:
     t = time.perf_counter()
     cla = curvenet.surface(path, method="classical")
     t_c = time.perf_counter() - t
     t = time.perf_counter()
     neu = curvenet.surface(path, method="neural", quality=quality)
     t_n = time.perf_counter() - t
+    if meshes is not None:
+        for route, res in (("classical", cla), ("neural", neu)):
+            res.mesh.export(meshes / f"{name.replace('/', '_')}_{route}.ply")
     c, n = _measure(cla), _measure(neu)
     f1, f2 = (evaluate_mesh(neu.mesh, cla.mesh, n_samples=30_000, threshold=th)["fscore"]
               for th in (0.01, 0.02))
@@ -61,15 +67,14 @@ def _row(name: str, path: Path, quality: str) -> dict:
 
 
 def _paths(names):
-    if not names:
-        root = DATA / SETS["vns"][0]
-        return [(f"vns/{p.relative_to(root).with_suffix('').as_posix()}", p)
-                for p in sorted(root.rglob("*.obj"))]
     out = []
     for name in names:
-        set_name, stem = name.split("/", 1)
+        set_name, _, stem = name.partition("/")
         folder, suffix = SETS[set_name]
-        out.append((name, DATA / folder / f"{stem}{suffix}"))
+        root = DATA / folder
+        paths = [root / f"{stem}{suffix}"] if stem else sorted(root.rglob(f"*{suffix}"))
+        out += [(f"{set_name}/{p.relative_to(root).with_suffix('').as_posix()}", p)
+                for p in paths]
     return out
 
 
@@ -79,17 +84,21 @@ def main() -> None:
     ap.add_argument("--sketches", default="", help="comma-separated SET/STEM names")
     ap.add_argument("--quality", default="default", choices=("draft", "default", "paper"))
     ap.add_argument("--threads", type=int, default=0, help="torch threads (0: torch's)")
+    ap.add_argument("--meshes", type=Path, default=None,
+                    help="folder for both surfaces of each sketch (SET_STEM_ROUTE.ply)")
     args = ap.parse_args()
     if args.threads:
         import torch
         torch.set_num_threads(args.threads)
+    if args.meshes is not None:
+        args.meshes.mkdir(parents=True, exist_ok=True)
     out = Path(args.out)
     with open(out, "w") as fh:
         fh.write("\t".join(COLUMNS) + "\n")
     rows = []
-    for name, path in _paths(list(filter(None, args.sketches.split(",")))):
+    for name, path in _paths(list(filter(None, args.sketches.split(","))) or ["vns"]):
         try:
-            row = _row(name, path, args.quality)
+            row = _row(name, path, args.quality, args.meshes)
         except Exception as err:  # noqa: BLE001 - a failed sketch is a row, not the end
             row = dict.fromkeys(COLUMNS, "-") | {"sketch": f"{name}: {err}"[:80]}
         rows.append(row)
