@@ -10,7 +10,12 @@ cotangent Laplacian and ``M`` the Voronoi mass matrix of the extracted mesh ``V`
 1. the shape: ``Y`` minimises ``|L Y|^2_{M^-1} + alpha |Y - V|^2_M``, whose response to
    a ripple of wavenumber ``k`` is ``1 / (1 + k^4 / alpha)``; ``alpha = (2 pi / (cutoff
    h))^4`` removes ripples shorter than ``cutoff`` cells ``h`` and keeps the shape at
-   larger scales without the shrinking of Laplacian smoothing;
+   larger scales without the shrinking of Laplacian smoothing. Away from the strokes
+   that pull (step 2) no data holds the shape, and the lumps there are the widest: per
+   vertex, the cutoff grows from its value within ``cutoff / 2 pi`` cells of a pulled
+   stroke sample (the filter's own reach) to :data:`SPREAD` times it at ``cutoff / 2``
+   cells and beyond (``alpha`` scaled by ``SPREAD^-4t``, ``t`` linear in the distance
+   in between);
 2. the way onto the strokes: ``X = Y + D`` minimises ``|L D|^2_{M^-1} + alpha_2 |D|^2_M
    + sum_s beta_s |B_s X - t_s|^2``, with ``B_s`` the barycentric row of the closest
    surface point of each stroke sample ``s`` within ``reach`` grid cells of ``V`` and
@@ -39,6 +44,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.linalg import splu
+from scipy.spatial import cKDTree
 
 __all__ = ["attach_to_strokes", "HELD", "SPREAD"]
 
@@ -120,11 +126,15 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
     m[:len(md)] = md
     m = np.maximum(m, 1e-12 * m.max())
     bend = L.T @ sp.diags(1.0 / m) @ L
-    alpha = (2.0 * np.pi / (cutoff * h)) ** 4
-    Y = _solve(bend + alpha * sp.diags(m), alpha * (m[:, None] * V))       # step 1: the shape
     S = np.concatenate([densify_polyline(np.asarray(s, np.float64), h) for s in strokes])
     near = np.sqrt(np.maximum(igl.point_mesh_squared_distance(S, V, F)[0], 0.0)) < reach * h
     S = S[near]
+    alpha = (2.0 * np.pi / (cutoff * h)) ** 4 * m
+    if weight > 0 and len(S):     # the cutoff grows to SPREAD times itself away from them
+        d = cKDTree(S).query(V)[0] / h
+        r0 = cutoff / (2.0 * np.pi)
+        alpha *= SPREAD ** (-4.0 * np.clip((d - r0) / (cutoff / 2.0 - r0), 0.0, 1.0))
+    Y = _solve(bend + sp.diags(alpha), alpha[:, None] * V)                 # step 1: the shape
     if weight == 0 or not len(S):
         return Y, {"samples": int(len(near)), "pulled": int(len(S)), "held": 0}
     d2, fi, closest = igl.point_mesh_squared_distance(S, Y, F)

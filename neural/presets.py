@@ -151,7 +151,8 @@ class FlowConfig:
     attach : float
         After the extraction (and the polish), fair the mesh and pull it onto the
         strokes near it (:func:`neural.attach.attach_to_strokes`): ripples shorter
-        than this many grid cells are removed; 0 keeps the mesh as extracted. The
+        than this many grid cells are removed next to the strokes, and up to twice as
+        long away from them; 0 keeps the mesh as extracted. The
         result is returned only when its stroke fidelity is at least the extracted
         mesh's; ``report["attach"]`` gives both. Not with ``anchors`` (hybrid fills).
         Not in the paper.

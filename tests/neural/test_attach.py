@@ -128,3 +128,19 @@ def test_the_pull_onto_strokes_off_the_surface_leaves_no_seam_of_dents():
     assert d.max() < band                                  # on its strokes
     assert np.linalg.norm(X1, axis=1).max() > 1.03         # bent out to them
     assert roughness((X1, F))["p90"] < 1.5 * roughness((X0, F))["p90"]
+
+
+def test_away_from_the_pulling_strokes_the_cutoff_doubles():
+    """One stroke on the equator: beyond half a cutoff from it (the polar caps) the bumps
+    are low-passed at twice the cutoff, smoother than the same filter holds them at the
+    cutoff alone (0.66 against 1.59 thousandths here; the bumps: 28)."""
+    V, F = _bumpy_sphere()
+    t = np.linspace(0, 2 * np.pi, 400)
+    h, cutoff = 0.05, 6.0
+    X, rep = attach_to_strokes(V, F, [np.c_[np.cos(t), np.sin(t), 0 * t]], h,
+                               cutoff=cutoff, weight=100.0)
+    Z, _ = attach_to_strokes(V, F, [np.c_[np.cos(t), np.sin(t), 0 * t]], h,
+                             cutoff=cutoff, weight=0.0)        # the cutoff everywhere
+    assert rep["pulled"] > 0
+    caps = F[(np.abs(V[:, 2]) > np.sin(cutoff / 2 * h))[F].all(1)]
+    assert roughness((X, caps))["median"] < 0.6 * roughness((Z, caps))["median"]
