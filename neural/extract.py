@@ -34,7 +34,7 @@ from scipy.spatial import cKDTree
 from curvenet.core.geometry import densify_polyline
 
 __all__ = ["marching_cubes_world", "face_components", "keep_supported_components",
-           "cut_along_boundary"]
+           "drop_redundant_bubbles", "cut_along_boundary"]
 
 
 def marching_cubes_world(f_grid: np.ndarray, origin: np.ndarray, spacing: float,
@@ -101,6 +101,72 @@ def keep_supported_components(vertices, faces, strokes, tol):
     if not good.any():
         return vertices, faces
     return _compact(vertices, faces[good[lab]])
+
+
+def drop_redundant_bubbles(vertices, faces, strokes, tol):
+    """Drop the closed pieces whose strokes the other pieces already carry.
+
+    A piece carries the stroke samples within ``tol`` of its surface. The pieces other
+    than the largest that are closed (every edge shared by two of their faces: the
+    field's small bubbles, inside the solid or beside it) are visited from the
+    smallest; one is dropped when every sample it carries is also carried by a piece
+    still kept. So no stroke sample loses its last surface within ``tol``, and a small
+    closed part drawn with strokes of its own stays.
+
+    Parameters
+    ----------
+    vertices : (V, 3) float64, faces : (F, 3) int64
+    strokes : list of (n, 3) float64
+    tol : float, world distance
+
+    Returns
+    -------
+    vertices, faces : the kept mesh (unused vertices removed)
+    n_dropped : int, pieces dropped
+    """
+    import igl
+
+    if len(faces) == 0 or not strokes:
+        return vertices, faces, 0
+    lab = face_components(faces, len(vertices))
+    n = lab.max() + 1
+    # closed pieces: every undirected edge used by exactly two faces
+    e = np.sort(faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+    _, inv, uses = np.unique(e, axis=0, return_inverse=True, return_counts=True)
+    closed = np.ones(n, dtype=bool)
+    closed[np.repeat(lab, 3)[uses[inv.ravel()] != 2]] = False
+    size = np.bincount(lab, minlength=n)
+    closed[np.argmax(size)] = False                       # never the largest
+    if not closed.any():
+        return vertices, faces, 0
+    # the samples near a candidate: within tol of its surface, so within tol plus its
+    # longest edge of one of its vertices
+    cand_f = faces[closed[lab]]
+    reach = tol + np.linalg.norm(vertices[cand_f] - vertices[np.roll(cand_f, 1, axis=1)],
+                                 axis=2).max()
+    pts = np.vstack([densify_polyline(st, tol / 2) for st in strokes])
+    d, _ = cKDTree(vertices[np.unique(cand_f)]).query(pts, distance_upper_bound=reach)
+    q = pts[np.isfinite(d)]
+    if not len(q):                                        # candidates that carry nothing
+        return (*_compact(vertices, faces[~closed[lab]]), int(closed.sum()))
+    vlab = np.full(len(vertices), -1, dtype=np.int64)
+    vlab[faces.reshape(-1)] = np.repeat(lab, 3)
+    near = cKDTree(vertices).query_ball_point(q, reach)
+    pieces = np.unique(vlab[np.concatenate([np.asarray(v, dtype=np.int64) for v in near])])
+    carry = np.zeros((len(q), n), dtype=bool)             # (samples near candidates, pieces)
+    for p in pieces[pieces >= 0]:
+        d2 = igl.point_mesh_squared_distance(q, vertices, faces[lab == p])[0]
+        carry[:, p] = d2 < tol * tol
+    held = carry.sum(axis=1)
+    alive = np.ones(n, dtype=bool)
+    for c in np.argsort(size, kind="stable"):
+        if closed[c] and np.all(held[carry[:, c]] >= 2):
+            alive[c] = False
+            held[carry[:, c]] -= 1
+    if alive.all():
+        return vertices, faces, 0
+    V, F = _compact(vertices, faces[alive[lab]])
+    return V, F, int((~alive).sum())
 
 
 def _compact(vertices, faces):

@@ -66,7 +66,10 @@ Engineering choices (documented deviations / gap fills)
   (:func:`_polished`): on sketches whose surface the strokes' extra density holds
   in place (open rims), the re-integration moves it off them.
 * Final mesh: pieces of the zero set with no stroke within 4 grid cells are
-  dropped (spurious level-set components of the periodic f).
+  dropped (spurious level-set components of the periodic f), and after the fairing
+  the closed pieces whose strokes the other pieces already carry within the stroke
+  fidelity's tolerance (:func:`neural.extract.drop_redundant_bubbles`: the field's
+  small bubbles inside the solid or beside it; not for hybrid fills).
 * ``attach > 0`` (draft, default): the extracted mesh is faired and pulled onto the
   strokes near it (:mod:`neural.attach`, a stroke-constrained bi-Laplacian low-pass of
   the vertices; the stroke samples it leaves farther than ``attach_band`` of the
@@ -264,13 +267,20 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
         # the polish measured the fidelity of the mesh it returned
         before = None if polish is None else polish["fidelity"][int(polish["kept"])]
         V, attach = _attached(V, F, strokes, h_world, cfg, before)
+    n_bubbles = 0
+    if anchors is None and len(F):
+        from curvenet.core.fidelity import FIDELITY_TOL_REL
+
+        from .extract import drop_redundant_bubbles
+        V, F, n_bubbles = drop_redundant_bubbles(V, F, strokes,
+                                                 FIDELITY_TOL_REL * bbox_diagonal(list(strokes)))
     for _ in range(int(cfg.subdivide) if anchors is None and len(F) else 0):
         V, F = subdivide_curved(V, F)
     timings["extract"] = time.perf_counter() - t0
     timings["total"] = time.perf_counter() - t_start
     report = {"steps": steps_done, "interrupted": interrupted, "device": str(dev), "seed": seed,
               "quality": quality, "config": cfg.as_dict(), "n_vertices": len(V),
-              "n_faces": len(F), "cut_faces": n_cut,
+              "n_faces": len(F), "cut_faces": n_cut, "bubbles_dropped": n_bubbles,
               "stroke_length_unit": fit.sampler.total_length}
     if polish is not None:
         report["polish"] = polish

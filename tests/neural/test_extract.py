@@ -3,8 +3,8 @@
 import numpy as np
 import trimesh
 
-from curvenet.neural.extract import (cut_along_boundary, face_components, keep_supported_components,
-                                     marching_cubes_world)
+from curvenet.neural.extract import (cut_along_boundary, drop_redundant_bubbles, face_components,
+                                     keep_supported_components, marching_cubes_world)
 
 
 def _sphere_grid(n=40, r=0.3):
@@ -43,6 +43,34 @@ def test_keep_supported_components_drops_far_piece():
     stroke = np.c_[np.cos(t), np.sin(t), 0 * t]
     V2, F2 = keep_supported_components(V, F, [stroke], 0.05)
     assert len(F2) == len(a.faces) and np.abs(np.linalg.norm(V2, axis=1) - 1).max() < 1e-9
+
+
+def test_bubbles_whose_strokes_the_surface_carries_are_dropped_a_drawn_part_stays():
+    """A unit sphere with great-circle strokes, a bubble inside it touching a stroke, one
+    beside it, and a small ball drawn with a stroke of its own: the two bubbles go, the
+    ball stays, and every stroke keeps a surface within the tolerance."""
+    from curvenet.core.fidelity import sketch_fidelity
+    t = np.linspace(0, 2 * np.pi, 200)
+    strokes = [np.c_[np.cos(t), np.sin(t), 0 * t], np.c_[np.cos(t), 0 * t, np.sin(t)],
+               np.c_[0.1 * np.cos(t) + 3, 0.1 * np.sin(t), 0 * t]]
+    pieces = [trimesh.creation.icosphere(3, radius=1.0)]
+    for radius, centre in ((0.03, (0.96, 0, 0)), (0.02, (0, 1.03, 0)), (0.1, (3, 0, 0))):
+        s = trimesh.creation.icosphere(2, radius=radius)
+        s.apply_translation(centre)
+        pieces.append(s)
+    V = np.vstack([p.vertices for p in pieces])
+    F = np.vstack([p.faces + sum(len(q.vertices) for q in pieces[:i])
+                   for i, p in enumerate(pieces)])
+    V2, F2, dropped = drop_redundant_bubbles(V, F, strokes, 0.05)
+    assert dropped == 2 and len(np.unique(face_components(F2, len(V2)))) == 2
+    assert np.isclose(V2[:, 0].max(), 3.1) and np.abs(V2).max() <= 3.1 + 1e-9
+    before, after = (sketch_fidelity(m, strokes)["surface"] for m in ((V, F), (V2, F2)))
+    assert after == before == 1.0
+    # an open piece is never dropped, nor the largest
+    V3, F3, n3 = drop_redundant_bubbles(V, np.vstack([F[:-1]]), strokes, 0.05)
+    assert n3 == 2
+    one = pieces[0]
+    assert drop_redundant_bubbles(one.vertices, one.faces, strokes, 0.05)[2] == 0
 
 
 def test_cut_removes_unsupported_cap_beyond_boundary_loop():
