@@ -31,7 +31,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
-from curvenet.core.geometry import densify_polyline
+from curvenet.core.geometry import densify_polyline, face_edges
 
 __all__ = ["marching_cubes_world", "face_components", "keep_supported_components",
            "drop_redundant_bubbles", "cut_along_boundary"]
@@ -131,8 +131,8 @@ def drop_redundant_bubbles(vertices, faces, strokes, tol):
     lab = face_components(faces, len(vertices))
     n = lab.max() + 1
     # closed pieces: every undirected edge used by exactly two faces
-    e = np.sort(faces[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
-    _, inv, uses = np.unique(e, axis=0, return_inverse=True, return_counts=True)
+    _, inv, uses = np.unique(face_edges(faces), axis=0, return_inverse=True,
+                             return_counts=True)
     closed = np.ones(n, dtype=bool)
     closed[np.repeat(lab, 3)[uses[inv.ravel()] != 2]] = False
     size = np.bincount(lab, minlength=n)

@@ -33,6 +33,7 @@ __all__ = [
     "resample_polyline",
     "densify_polyline",
     "face_normals_areas",
+    "face_edges",
     "boundary_edges",
     "subdivide_curved",
     "sample_surface",
@@ -380,12 +381,19 @@ def boundary_edges(faces: np.ndarray) -> np.ndarray:
     >>> boundary_edges(np.array([[0, 1, 2], [2, 1, 3]])).tolist()
     [[0, 1], [0, 2], [1, 3], [2, 3]]
     """
-    edges, count = np.unique(_face_edges(faces), axis=0, return_counts=True)
+    edges, count = np.unique(face_edges(faces), axis=0, return_counts=True)
     return edges[count == 1]
 
 
-def _face_edges(faces) -> np.ndarray:
-    """(3 F, 2) int64: each triangle's edges ``ab, bc, ca`` in turn, the smaller id first."""
+def face_edges(faces) -> np.ndarray:
+    """(3 F, 2) int64: each triangle's edges ``ab, bc, ca`` in turn, the smaller id first
+    (row ``3 i + k`` is edge ``k`` of face ``i``).
+
+    Examples
+    --------
+    >>> face_edges(np.array([[2, 0, 1]])).tolist()
+    [[0, 2], [0, 1], [1, 2]]
+    """
     f = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
     return np.sort(f[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
 
@@ -430,7 +438,7 @@ def subdivide_curved(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarra
     n = np.stack([np.bincount(f.ravel(), contrib[:, k], minlength=len(V)) for k in range(3)],
                  axis=1)
     n /= np.maximum(np.linalg.norm(n, axis=1), DIVISION_GUARD)[:, None]     # unused: zero
-    edges, inverse = np.unique(_face_edges(f), axis=0, return_inverse=True)
+    edges, inverse = np.unique(face_edges(f), axis=0, return_inverse=True)
     p, q = V[edges[:, 0]], V[edges[:, 1]]
     np_, nq = n[edges[:, 0]], n[edges[:, 1]]
     e = q - p
