@@ -79,7 +79,8 @@ def _solve(A, rhs) -> np.ndarray:
 
 
 def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
-                      band: float = 0.0, reach: float = 3.0) -> tuple[np.ndarray, dict]:
+                      band: float = 0.0, reach: float = 3.0,
+                      points=None) -> tuple[np.ndarray, dict]:
     """Fair the mesh ``(V, F)`` and pull it onto the stroke samples near it.
 
     Parameters
@@ -99,13 +100,17 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
         holding, the pull ``weight`` alone. Ignored when ``weight`` is 0.
     reach : float
         Stroke samples farther than this many cells from ``V`` are left out.
+    points : (p, 3) float64, optional
+        More samples, pulled (and held) like the strokes' (a hybrid fill's anchors:
+        points of the patches it meets).
 
     Returns
     -------
     X : (n, 3) float64
         The new vertex positions (``F`` unchanged).
     report : dict
-        ``samples`` (stroke samples drawn, one per cell of stroke length), ``pulled``
+        ``samples`` (stroke samples drawn, one per cell of stroke length, and
+        ``points``), ``pulled``
         (those within reach) and ``held`` (those held to the band).
     """
     import igl
@@ -126,7 +131,8 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
     m[:len(md)] = md
     m = np.maximum(m, 1e-12 * m.max())
     bend = L.T @ sp.diags(1.0 / m) @ L
-    S = np.concatenate([densify_polyline(np.asarray(s, np.float64), h) for s in strokes])
+    S = np.concatenate([densify_polyline(np.asarray(s, np.float64), h) for s in strokes]
+                       + ([] if points is None else [np.asarray(points, np.float64)]))
     near = np.sqrt(np.maximum(igl.point_mesh_squared_distance(S, V, F)[0], 0.0)) < reach * h
     S = S[near]
     alpha = (2.0 * np.pi / (cutoff * h)) ** 4 * m

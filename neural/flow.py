@@ -75,9 +75,10 @@ Engineering choices (documented deviations / gap fills)
   the vertices; the stroke samples it leaves farther than ``attach_band`` of the
   strokes' diagonal are held to that band), and returned so only when its stroke
   fidelity is at least the extracted mesh's. ``FlowResult.f_grid`` stays the field
-  whose zero set was extracted. Not with ``anchors``: a fill beside classical patches
-  must meet their surface, which the fairing does not see (the hybrid route closes
-  that seam itself).
+  whose zero set was extracted. With ``anchors`` (a hybrid fill) the anchor points
+  pull like stroke samples, so the faired fill still meets the patches, and nothing
+  is held to the band: a fill's strokes are the loose ones no patch closes, and
+  holding each of them drags thin sheets of the fill onto the strays (spikes).
 * ``subdivide`` (draft, default): the final mesh is subdivided once, its new vertices
   on the curved point-normal triangles of the old ones
   (:func:`curvenet.core.geometry.subdivide_curved`): the facets of a mesh extracted
@@ -263,10 +264,11 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
         mesh, polish = _polished(fit, f_final, mesh, strokes, labels, cut_boundary)
     V, F, f_np, origin, h_world, n_cut = mesh
     attach = None
-    if cfg.attach > 0 and not interrupted and len(F) and anchors is None:
+    if cfg.attach > 0 and not interrupted and len(F):
         # the polish measured the fidelity of the mesh it returned
         before = None if polish is None else polish["fidelity"][int(polish["kept"])]
-        V, attach = _attached(V, F, strokes, h_world, cfg, before)
+        V, attach = _attached(V, F, strokes, h_world, cfg, before,
+                              None if anchors is None else anchors[0])
     n_bubbles = 0
     if anchors is None and len(F):
         from curvenet.core.fidelity import FIDELITY_TOL_REL
@@ -308,14 +310,21 @@ def _polished(fit: FlowFit, f, mesh, strokes, labels, cut_boundary):
     return (polished if kept else mesh), {"fidelity": fidelity, "kept": kept}
 
 
-def _attached(V, F, strokes, h_world, cfg: FlowConfig, before: float | None = None):
+def _attached(V, F, strokes, h_world, cfg: FlowConfig, before: float | None = None,
+              anchors=None):
     """The mesh faired onto its strokes (:func:`neural.attach.attach_to_strokes`) if it
     holds at least as much of them; ``(V, {"fidelity": [before, after], "kept": bool,
-    "samples", "pulled", "held"})``. ``before``: the stroke fidelity of ``(V, F)`` when known."""
+    "samples", "pulled", "held"})``. ``before``: the stroke fidelity of ``(V, F)`` when known.
+
+    ``anchors`` ((m, 3) float64, a hybrid fill's anchor points) pull like stroke samples,
+    and nothing is held to the band: a fill's strokes are the loose strokes no patch
+    closes, and holding every one of them drags thin sheets of the fill onto the strays.
+    """
     from .attach import attach_to_strokes
-    band = cfg.attach_band * bbox_diagonal(list(strokes))
+    band = 0.0 if anchors is not None else cfg.attach_band * bbox_diagonal(list(strokes))
     X, rep = attach_to_strokes(V, F, strokes, h_world, cutoff=cfg.attach,
-                               weight=cfg.attach_weight, band=band, reach=cfg.attach_reach)
+                               weight=cfg.attach_weight, band=band, reach=cfg.attach_reach,
+                               points=anchors)
     if before is None:
         before = _fidelity(V, F, strokes)
     fidelity = [before, _fidelity(X, F, strokes)]

@@ -154,8 +154,8 @@ class FlowConfig:
         than this many grid cells are removed next to the strokes, and up to twice as
         long away from them; 0 keeps the mesh as extracted. The
         result is returned only when its stroke fidelity is at least the extracted
-        mesh's; ``report["attach"]`` gives both. Not with ``anchors`` (hybrid fills).
-        Not in the paper.
+        mesh's; ``report["attach"]`` gives both. With ``anchors`` (hybrid fills) their
+        points pull too and nothing is held to ``attach_band``. Not in the paper.
     attach_weight : float
         Pull of the stroke samples in that fairing (0 = the low-pass alone).
     attach_band : float

@@ -308,10 +308,13 @@ def test_a_fill_beside_patches_meets_them_along_the_shared_curve():
     faces = res.mesh.faces[res.face_route == 1]
     centres = res.mesh.vertices[faces].mean(axis=1)
     # nothing of the fill lies on the box's top face (that part is the patch's): within
-    # tol of its plane, inside its edge (at res=40 a face of the fill can dip below the
+    # tol of its plane, inside its edges (at res=40 a face of the fill can dip below the
     # top face near the edge, inside the box; with numpy 2.4 / scipy 1.17 one of 672 lies
-    # 0.039 under it)
-    assert not ((centres[:, 0] < 1.0 - tol) & (np.abs(centres[:, 2] - 1.0) < tol)).any()
+    # 0.039 under it). Faces on the top's other edges (y = 0, 1), within the trim's
+    # on_curve = tol / 2 of them, lie across a patch curve and are kept by design: the
+    # faired fill leaves 4 of 741 there
+    inside = (centres[:, 0] < 1.0 - tol) & (np.abs(centres[:, 1] - 0.5) < 0.5 - tol / 2)
+    assert not (inside & (np.abs(centres[:, 2] - 1.0) < tol)).any()
     # the fill's boundary runs along the shared edge where the awning leaves it
     edge = np.c_[0 * T + 1.0, 0.15 + 0.7 * T, 0 * T + 1.0]
     seam = fill_seam(res.mesh.vertices, faces, [edge], gap=0.08, tol=tol)

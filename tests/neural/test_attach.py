@@ -144,3 +144,26 @@ def test_away_from_the_pulling_strokes_the_cutoff_doubles():
     assert rep["pulled"] > 0
     caps = F[(np.abs(V[:, 2]) > np.sin(cutoff / 2 * h))[F].all(1)]
     assert roughness((X, caps))["median"] < 0.6 * roughness((Z, caps))["median"]
+
+
+def test_extra_points_pull_like_stroke_samples():
+    """A hybrid fill's anchors: points of the true sphere on a cap where no stroke is pull
+    the shrunken sphere out onto it, as stroke samples there would; far points do not."""
+    import igl
+    V, F = _bumpy_sphere()
+    t = np.linspace(0, 2 * np.pi, 400)
+    equator = [np.c_[np.cos(t), np.sin(t), 0 * t]]
+    rng = np.random.default_rng(0)
+    cap = rng.normal(size=(4000, 3))
+    cap /= np.linalg.norm(cap, axis=1)[:, None]
+    cap = cap[cap[:, 2] > 0.6][:500]
+    h, kw = 0.05, dict(cutoff=6.0, weight=100.0)
+    X, rep = attach_to_strokes(V, F, equator, h, points=cap, **kw)
+    Y, rep0 = attach_to_strokes(V, F, equator, h, **kw)
+    assert rep["samples"] == rep0["samples"] + len(cap) and rep["pulled"] > rep0["pulled"]
+    d = [np.sqrt(igl.point_mesh_squared_distance(cap, P, F)[0]) for P in (X, Y)]
+    assert np.median(d[1]) > 0.03 and np.median(d[0]) < 0.3 * np.median(d[1])
+    # points beyond the reach are left out: the same as none
+    Z, rep2 = attach_to_strokes(V, F, equator, h, points=cap + [0.0, 0.0, 2.0], **kw)
+    assert rep2["pulled"] == rep0["pulled"]
+    np.testing.assert_allclose(Z, Y, atol=1e-9)
