@@ -94,14 +94,7 @@ def uneven_tori(n: int, seed: int = 30):
 
 def _moved(shape, rng):
     """The shape turned, scaled and moved at random: network and true surface alike."""
-    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-    q *= np.sign(np.linalg.det(q))
-    scale = float(10.0 ** rng.uniform(-1, 2))
-    shift = rng.normal(size=3) * scale
-
-    def move(p):
-        return scale * np.asarray(p, np.float64) @ q.T + shift
-
+    move = shapes.random_motion(rng)
     net = shape.network
     moved = CurveNetwork(move(net.positions))
     for e in net.edges:

@@ -34,6 +34,7 @@ import numpy as np
 import curvenet
 from curvenet.core.distance import point_surface_distance
 from curvenet.core.geometry import bbox_diagonal
+from curvenet.datasets.shapes import random_motion
 from curvenet.evaluate import evaluate_mesh, roughness
 from curvenet.model.sketch import Sketch
 
@@ -62,14 +63,7 @@ def case(seed: int):
         span, start = rng.uniform(0.7, 0.85), rng.uniform(0, 2 * np.pi)
         strokes.append(_point(radii, 0 * t - np.pi / 2 * k / (n_arc + 1),
                               start + 2 * np.pi * span * t))
-    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-    q *= np.sign(np.linalg.det(q))
-    scale = float(10.0 ** rng.uniform(-1, 2))
-    shift = rng.normal(size=3) * scale
-
-    def move(p):
-        return scale * np.asarray(p, np.float64) @ q.T + shift
-
+    move = random_motion(rng)
     sphere = trimesh.creation.icosphere(6)
     truth = (move(sphere.vertices * radii), np.asarray(sphere.faces))
     name = f"ellipsoid {radii[1]:.2f},{radii[2]:.2f} {n_mer}m{len(rings)}r{n_arc}a"

@@ -39,7 +39,7 @@ from ..model.sketch import Sketch
 __all__ = [
     "AnalyticShape", "box", "grid_box", "l_prism", "house", "two_boxes", "latlong_sphere",
     "ellipsoid", "capped_cylinder", "torus", "saddle_grid", "grid_sheet", "SHAPES",
-    "sample_curves",
+    "sample_curves", "random_motion",
     "washer", "holed_plate", "hex_nut", "flange", "boss_box", "l_bracket", "CAD_SHAPES",
 ]
 
@@ -519,6 +519,37 @@ SHAPES = {
     "saddle": saddle_grid,
     "grid_sheet": grid_sheet,
 }
+
+
+def random_motion(rng):
+    """A random similarity (turn, scale in [0.1, 100], shift), for inputs in no special pose.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+
+    Returns
+    -------
+    callable
+        ``move(points)``: (n, 3) array_like -> (n, 3) float64 moved points.
+
+    Examples
+    --------
+    >>> move = random_motion(np.random.default_rng(0))
+    >>> a, b = move([[0, 0, 0], [1, 0, 0]])
+    >>> c, d = move([[0, 0, 0], [0, 1, 0]])
+    >>> bool(np.isclose(np.linalg.norm(b - a), np.linalg.norm(d - c)))
+    True
+    """
+    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    q *= np.sign(np.linalg.det(q))
+    scale = float(10.0 ** rng.uniform(-1, 2))
+    shift = rng.normal(size=3) * scale
+
+    def move(p):
+        return scale * np.asarray(p, np.float64) @ q.T + shift
+
+    return move
 
 
 def sample_curves(curves, spacing: float, *, noise: float = 0.0, uneven: float = 1.0,
