@@ -110,8 +110,8 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
         The new vertex positions (``F`` unchanged).
     report : dict
         ``samples`` (stroke samples drawn, one per cell of stroke length, and
-        ``points``), ``pulled``
-        (those within reach) and ``held`` (those held to the band).
+        ``points``), ``pulled`` (those within reach) and ``held`` (those held to the
+        band).
     """
     import igl
 
