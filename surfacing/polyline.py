@@ -12,17 +12,19 @@ from __future__ import annotations
 
 import numpy as np
 
-from curvenet.core.geometry import sample_at
+from curvenet.core.geometry import arc_length, sample_at
 from curvenet.core.tolerances import DIVISION_GUARD
 
 __all__ = ["end_tangents", "point_polyline_distance"]
 
 
-def end_tangents(curve: np.ndarray, fraction: float = 0.1) -> tuple[np.ndarray, np.ndarray]:
+def end_tangents(curve: np.ndarray, fraction: float = 0.1,
+                 lengths=None) -> tuple[np.ndarray, np.ndarray]:
     """Unit tangents at both ends of a polyline, pointing *away from* each end.
 
     The direction is taken to the point at ``fraction`` of the arc length from the
-    end, which is robust to a noisy last sample.
+    end, which is robust to a noisy last sample; or, with ``lengths = (l0, l1)``, to
+    the points at arc length ``l0`` from the start and ``l1`` from the end.
 
     Returns
     -------
@@ -31,7 +33,11 @@ def end_tangents(curve: np.ndarray, fraction: float = 0.1) -> tuple[np.ndarray, 
         the curve. Zero vectors for a zero-length curve.
     """
     curve = np.asarray(curve, dtype=np.float64)
-    p = sample_at(curve, np.array([fraction, 1.0 - fraction]))
+    t = np.array([fraction, 1.0 - fraction])
+    if lengths is not None:
+        total = arc_length(curve)
+        t = np.array([lengths[0], total - lengths[1]]) / max(total, DIVISION_GUARD)
+    p = sample_at(curve, t)
     d0, d1 = p[0] - curve[0], p[1] - curve[-1]
     n0, n1 = np.linalg.norm(d0), np.linalg.norm(d1)
     return (d0 / n0 if n0 > 0 else d0), (d1 / n1 if n1 > 0 else d1)

@@ -6,24 +6,35 @@ by more than ``straight_angle`` there; consecutive curves meeting nearly straigh
 (a T-junction on the patch border) stay in one side, so a loop of five curves with
 one T-junction is a four-sided patch.
 
+The turn at a junction is measured between the chords to the points at the same arc
+length on both sides, :data:`TANGENT_FRACTION` of the shorter curve's length: chords
+of a tenth of each curve's own length read the sag of a long curve's chord as a turn
+where a short curve meets it on a bend (where a closed stroke began on a tight bend,
+a smooth curve came out cornered).
+
 Notes
 -----
 Orbay & Kara 2011 (Sec. 4.2) surface four-sided loops only and take each curve as
 a side; grouping at T-junctions is our extension (the issue asks for it). The
-turning angle is measured between chords to the point at 10% of arc length from
-each end, which ignores a hooked last sample.
+turning angle is measured between chords (see above), which ignores a hooked last
+sample.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from curvenet.core.geometry import arc_length
+
 from .polyline import end_tangents
 
-__all__ = ["DEFAULT_STRAIGHT_ANGLE", "junction_angles", "group_sides"]
+__all__ = ["DEFAULT_STRAIGHT_ANGLE", "TANGENT_FRACTION", "junction_angles", "group_sides"]
 
 #: Turning angle in degrees below which two curves count as one side.
 DEFAULT_STRAIGHT_ANGLE = 30.0
+#: Arc length of the chords that measure a junction's turn, fraction of the shorter of
+#: the two curves meeting there.
+TANGENT_FRACTION = 0.1
 
 
 def junction_angles(loop_curves: list) -> np.ndarray:
@@ -42,10 +53,12 @@ def junction_angles(loop_curves: list) -> np.ndarray:
         (0: straight on; 180: doubling back).
     """
     n = len(loop_curves)
+    lengths = np.array([arc_length(c) for c in loop_curves])
+    scale = TANGENT_FRACTION * np.minimum(lengths, np.roll(lengths, 1))   # per junction
     t_start = np.empty((n, 3))
     t_end = np.empty((n, 3))
     for i, c in enumerate(loop_curves):
-        t_start[i], t_end[i] = end_tangents(c)
+        t_start[i], t_end[i] = end_tangents(c, lengths=(scale[i], scale[(i + 1) % n]))
     d_in = -np.roll(t_end, 1, axis=0)          # travel direction arriving at junction i
     d_out = t_start                             # travel direction leaving junction i
     cos = np.clip(np.einsum("ij,ij->i", d_in, d_out), -1.0, 1.0)

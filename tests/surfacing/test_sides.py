@@ -30,3 +30,16 @@ def test_smooth_closed_loop_has_no_corner():
 def test_straight_angle_is_validated():
     with pytest.raises(ValueError, match="straight_angle"):
         group_sides([_seg([0, 0, 0], [1, 0, 0])], straight_angle=200)
+
+
+def test_a_smooth_curve_split_near_a_tight_bend_has_no_corner():
+    """Half an ellipse of axes 1 and 0.25, split just before its tip: chords of a tenth of
+    each piece's own length read the long piece's sag as a 35 degree turn (a corner);
+    at the same arc length on both sides the turn is the curve's own, a few degrees."""
+    def arc(t0, t1):
+        t = np.linspace(t0, t1, 200)
+        return np.c_[np.cos(t), 0.25 * np.sin(t), 0 * t]
+    chord = np.c_[np.linspace(1, -1, 50), np.zeros(50), np.zeros(50)]
+    angles = junction_angles([arc(np.pi, 0.1), arc(0.1, 0.0), chord])
+    assert angles[1] < 5.0 and angles[0] > 90.0 and angles[2] > 90.0
+    assert group_sides([arc(np.pi, 0.1), arc(0.1, 0.0), chord]) == [[0, 1], [2]]
