@@ -298,9 +298,11 @@ def build_control_mesh(curves, loops, resolution: int = 4, *,
         loops = orient_loops(loops, len(curves))
     jend, jpos = _junctions(curves, loops, diag)
     closed = jend[:, 0] == jend[:, 1]
+    sides = [group_sides([curves[ci] if fwd else curves[ci][::-1] for ci, fwd in lp],
+                         straight_angle) if len(lp) >= 2 else [] for lp in loops]
     if adaptive:
         m, most, lengths = piece_counts(curves, closed)
-        k_c = N * equalise_pieces(m, loops, lengths, jend, most)
+        k_c = N * equalise_pieces(m, loops, lengths, jend, most, sides=sides)
     else:
         k_c = N * np.where(closed, 2, 1)
     curve_pos, curve_vids, samples = _sample_curves(curves, jend, jpos, k_c)
@@ -308,9 +310,8 @@ def build_control_mesh(curves, loops, resolution: int = 4, *,
     positions, quads_all, fpatch, kinds = [curve_pos], [], [], []
     swept: dict = {}                # (p, q) -> [(block in positions, its four sides)]
     for j, lp in enumerate(loops):
-        B, BP, starts, dense = _loop_boundary(lp, curves, curve_vids, samples)
-        kind, p, q, roll, sides = _patch_layout(lp, dense, starts, k_c, N, len(B),
-                                                straight_angle)
+        B, BP, starts = _loop_boundary(lp, curve_vids, samples)
+        kind, p, q, roll = _patch_layout(lp, sides[j], starts, k_c, N, len(B))
         kinds.append(kind)
         if kind in ("grid", "pieces4", "halves"):
             newpos, grid_sides, quads, nid = _grid_patch(np.roll(B, -roll),
@@ -318,7 +319,7 @@ def build_control_mesh(curves, loops, resolution: int = 4, *,
             if kind == "grid" and p > 1 and q > 1:
                 swept.setdefault((p, q), []).append((len(positions), grid_sides))
         else:
-            corners = [starts[s[0]] for s in sides] if kind == "split-coons4" else None
+            corners = [starts[s[0]] for s in sides[j]] if kind == "split-coons4" else None
             newpos, quads, nid = _split_patch(B, BP, N, nid, corners)
         positions.append(newpos)
         quads_all.append(quads)
@@ -372,7 +373,7 @@ def _sample_curves(curves, jend, jpos, k_c):
     return np.concatenate(pos_blocks), curve_vids, samples
 
 
-def _loop_boundary(lp, curves, curve_vids, samples):
+def _loop_boundary(lp, curve_vids, samples):
     """A loop's border in traversal order.
 
     Returns
@@ -383,10 +384,8 @@ def _loop_boundary(lp, curves, curve_vids, samples):
         Their positions.
     starts : list of int
         Index in ``B`` where each of the loop's curves starts.
-    dense : list of (m_i, 3) float64
-        The loop's curves, oriented along the loop.
     """
-    bids, bpos, starts, dense = [], [], [], []
+    bids, bpos, starts = [], [], []
     off = 0
     for ci, fwd in lp:
         ids = curve_vids[ci] if fwd else curve_vids[ci][::-1]
@@ -394,30 +393,28 @@ def _loop_boundary(lp, curves, curve_vids, samples):
         starts.append(off)
         bids.append(ids[:-1])
         bpos.append(ps[:-1])
-        dense.append(curves[ci] if fwd else curves[ci][::-1])
         off += len(ids) - 1
-    return np.concatenate(bids), np.concatenate(bpos), starts, dense
+    return np.concatenate(bids), np.concatenate(bpos), starts
 
 
-def _patch_layout(lp, dense, starts, k_c, N, Lb, straight_angle):
-    """How a loop is meshed: ``(kind, p, q, roll, sides)``.
+def _patch_layout(lp, sides, starts, k_c, N, Lb):
+    """How a loop is meshed: ``(kind, p, q, roll)``.
 
-    A grid of ``p x q`` quads when the loop has four sides with opposite sides of
-    equal sample counts (``"grid"``, border rolled by ``roll`` to start at a
-    corner), four pieces (``"pieces4"``) or at most two (``"halves"``); otherwise
-    a centre split (``"split-coons4"`` for four sides, else ``"split"``; ``p``,
-    ``q`` unused). ``sides`` are the groups of loop positions per side.
+    A grid of ``p x q`` quads when the loop has four sides (``sides``: the groups of
+    loop positions per side, :func:`.sides.group_sides`) with opposite sides of equal
+    sample counts (``"grid"``, border rolled by ``roll`` to start at a corner), four
+    pieces (``"pieces4"``) or at most two (``"halves"``); otherwise a centre split
+    (``"split-coons4"`` for four sides, else ``"split"``; ``p``, ``q`` unused).
     """
     T = Lb // N
-    sides = group_sides(dense, straight_angle) if len(lp) >= 2 else []
     side_len = [sum(int(k_c[lp[i][0]]) for i in s) for s in sides]
     if len(sides) == 4 and side_len[0] == side_len[2] and side_len[1] == side_len[3]:
-        return "grid", side_len[0], side_len[1], starts[sides[0][0]], sides
+        return "grid", side_len[0], side_len[1], starts[sides[0][0]]
     if T == 4:
-        return "pieces4", N, N, 0, sides
+        return "pieces4", N, N, 0
     if T <= 2:
-        return "halves", Lb // 4, Lb // 4, 0, sides
-    return ("split-coons4" if len(sides) == 4 else "split"), 0, 0, 0, sides
+        return "halves", Lb // 4, Lb // 4, 0
+    return ("split-coons4" if len(sides) == 4 else "split"), 0, 0, 0
 
 
 def _grid_patch(Br, BPr, p, q, nid):

@@ -36,7 +36,7 @@ from curvenet.core.tolerances import DIVISION_GUARD
 
 __all__ = ["piece_counts", "equalise_pieces", "continuations",
            "PIECE_LENGTH", "PIECE_TURN", "TURN_SEGMENTS", "TURN_SCALES", "PIECE_ROUNDING",
-           "DENSITY_RATIO"]
+           "DENSITY_RATIO", "BALANCE_ROUNDS"]
 
 #: Adaptive pieces: a curve gets one more piece of ``N`` segments per this many times the
 #: median curve length ...
@@ -59,6 +59,9 @@ PIECE_ROUNDING = 1e-9
 #: 2`` is allowed, one piece against two is not. Exact equality would ratchet up: curves
 #: of slightly different lengths cannot have equal integer densities.
 DENSITY_RATIO = 1.5
+#: Rounds of :func:`equalise_pieces`' balancing of four-sided loops whose sides are made
+#: of several curves (each round: every such loop once, then the continuations).
+BALANCE_ROUNDS = 4
 
 
 def _turning(curve: np.ndarray, n: int) -> float:
@@ -224,8 +227,9 @@ def continuations(loops: list, jend: np.ndarray) -> np.ndarray:
 
 
 def equalise_pieces(m: np.ndarray, loops: list, lengths: np.ndarray, jend: np.ndarray,
-                    most: np.ndarray) -> np.ndarray:
-    """Raise piece counts along quad strips and between continuing curves.
+                    most: np.ndarray, sides=None) -> np.ndarray:
+    """Raise piece counts along quad strips, across four-sided loops and between
+    continuing curves.
 
     Opposite curves of four-curve loops are joined into classes (the quad strips of the
     layout); every curve of a class takes the class maximum, so those loops stay
@@ -240,6 +244,14 @@ def equalise_pieces(m: np.ndarray, loops: list, lengths: np.ndarray, jend: np.nd
     on is no larger), so every strip is settled once and the cost is linear in the pairs
     (up to the heap's logarithm).
 
+    With ``sides``, a four-sided loop whose sides are made of several curves (a junction
+    of two curves in the middle of a side: where a closed stroke began, a T-junction)
+    is balanced too: the side with fewer pieces than its opposite side gets the
+    difference, a piece at a time to its curve of the lowest density (pieces per
+    length), its strip following, then the continuations again; for at most
+    :data:`BALANCE_ROUNDS` rounds (a layout whose sums cannot all agree keeps the
+    centre split on the loops left unbalanced).
+
     Parameters
     ----------
     m : (C,) int64
@@ -251,6 +263,9 @@ def equalise_pieces(m: np.ndarray, loops: list, lengths: np.ndarray, jend: np.nd
         Junction of each curve's start and end.
     most : (C,) int64
         The most pieces a continuation may give each curve (:func:`piece_counts`).
+    sides : list of list of list of int, optional
+        Per loop its sides, each a list of positions in the loop
+        (:func:`surfacing.sides.group_sides`).
 
     Returns
     -------
@@ -260,27 +275,56 @@ def equalise_pieces(m: np.ndarray, loops: list, lengths: np.ndarray, jend: np.nd
     lab = _strips(len(m), loops)
     best = np.zeros(lab.max() + 1 if len(lab) else 0, dtype=np.int64)
     np.maximum.at(best, lab, m)
+    length = np.maximum(np.asarray(lengths, np.float64), DIVISION_GUARD)
     pairs = continuations(loops, jend)
-    if len(pairs):
-        x = np.r_[pairs[:, 0], pairs[:, 1]]               # x continues y, both ways
-        y = np.r_[pairs[:, 1], pairs[:, 0]]
-        length = np.maximum(np.asarray(lengths, np.float64), DIVISION_GUARD)
-        ratio = length[x] / length[y] / DENSITY_RATIO
-        order = np.argsort(lab[y], kind="stable")
-        x, ratio = x[order], ratio[order]
-        cap = np.asarray(most, np.int64)[x]
-        start = np.searchsorted(lab[y][order], np.arange(len(best) + 1))
-        heap = [(-int(v), int(c)) for c, v in enumerate(best)]
-        heapq.heapify(heap)
-        while heap:
-            v, c = heapq.heappop(heap)
-            if -v != best[c]:
-                continue                                    # raised since it was pushed
-            s0, s1 = start[c], start[c + 1]
-            need = np.minimum(np.minimum(np.ceil(ratio[s0:s1] * -v - PIECE_ROUNDING), -v),
-                              cap[s0:s1]).astype(np.int64)
-            for t, k in zip(lab[x[s0:s1]], need):
-                if k > best[t]:
-                    best[t] = k
-                    heapq.heappush(heap, (-int(k), int(t)))
+    _raise_continuations(best, lab, pairs, length, np.asarray(most, np.int64))
+    split = [[[lp[i][0] for i in g] for g in sd] for lp, sd in zip(loops, sides or [])
+             if len(sd) == 4 and any(len(g) > 1 for g in sd)]
+    for _ in range(BALANCE_ROUNDS if split else 0):
+        if not _balance_sides(best, lab, length, split):
+            break
+        _raise_continuations(best, lab, pairs, length, np.asarray(most, np.int64))
     return best[lab]
+
+
+def _raise_continuations(best, lab, pairs, length, most) -> None:
+    """Raise ``best`` (per strip, in place) where a curve is too sparse beside its
+    continuation (:func:`equalise_pieces`)."""
+    if not len(pairs):
+        return
+    x = np.r_[pairs[:, 0], pairs[:, 1]]               # x continues y, both ways
+    y = np.r_[pairs[:, 1], pairs[:, 0]]
+    ratio = length[x] / length[y] / DENSITY_RATIO
+    order = np.argsort(lab[y], kind="stable")
+    x, ratio = x[order], ratio[order]
+    cap = most[x]
+    start = np.searchsorted(lab[y][order], np.arange(len(best) + 1))
+    heap = [(-int(v), int(c)) for c, v in enumerate(best)]
+    heapq.heapify(heap)
+    while heap:
+        v, c = heapq.heappop(heap)
+        if -v != best[c]:
+            continue                                    # raised since it was pushed
+        s0, s1 = start[c], start[c + 1]
+        need = np.minimum(np.minimum(np.ceil(ratio[s0:s1] * -v - PIECE_ROUNDING), -v),
+                          cap[s0:s1]).astype(np.int64)
+        for t, k in zip(lab[x[s0:s1]], need):
+            if k > best[t]:
+                best[t] = k
+                heapq.heappush(heap, (-int(k), int(t)))
+
+
+def _balance_sides(best, lab, length, split) -> bool:
+    """One round of side balancing (:func:`equalise_pieces`): per loop (its four sides as
+    curve lists), the opposite side with fewer pieces raised to the other's sum, a piece
+    at a time on its sparsest curve; ``best`` (per strip) in place. Whether any rose."""
+    changed = False
+    for sd in split:
+        for k in (0, 1):
+            a, c = np.asarray(sd[k]), np.asarray(sd[k + 2])
+            sa, sc = int(best[lab[a]].sum()), int(best[lab[c]].sum())
+            low = a if sa < sc else c
+            for _ in range(abs(sa - sc)):
+                best[lab[low[np.argmin(best[lab[low]] / length[low])]]] += 1
+            changed |= sa != sc
+    return changed

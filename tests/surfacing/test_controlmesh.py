@@ -67,16 +67,47 @@ def test_t_junctions_on_opposite_sides_give_one_grid():
 
 
 def test_five_curve_loop_is_four_sided():
-    # one T-junction: sides of 8, 4, 4, 4 segments cannot be one grid; the loop is
-    # still a 4-sided Coons patch, sampled through a Tutte embedding in the square
+    # one T-junction: with a curve's N segments each (adaptive=False), sides of 8, 4, 4, 4
+    # segments cannot be one grid; the loop is still a 4-sided Coons patch, sampled
+    # through a Tutte embedding in the square
     curves = [_seg([0, 0, 0], [0.5, 0, 0]), _seg([0.5, 0, 0], [1, 0, 0]),
               _seg([1, 0, 0], [1, 1, 0.5]), _seg([1, 1, 0.5], [0, 1, 0.5]),
               _seg([0, 1, 0.5], [0, 0, 0])]
-    cm = build_control_mesh(curves, [[(i, True) for i in range(5)]], 4)
+    loops = [[(i, True) for i in range(5)]]
+    cm = build_control_mesh(curves, loops, 4, adaptive=False)
     assert cm.patch_kind == ["split-coons4"]
     # the sides are straight, so the Coons patch is the ruled plane y = 2 z
     np.testing.assert_allclose(cm.vertices[:, 2], 0.5 * cm.vertices[:, 1], atol=1e-12)
     assert _tri(cm).area_faces.min() > 0
+    # adaptive pieces balance the sides: the top takes two pieces, one grid of 8 x 4
+    cm = build_control_mesh(curves, loops, 4)
+    assert cm.patch_kind == ["grid"] and cm.quads.shape == (8 * 4, 4)
+    assert [len(v) - 1 for v in cm.curve_vids] == [4, 4, 4, 8, 4]
+    np.testing.assert_allclose(cm.vertices[:, 2], 0.5 * cm.vertices[:, 1], atol=1e-12)
+
+
+def test_a_side_of_two_curves_balances_its_opposite_side():
+    """Sides are balanced by their sums, the sparsest curve of the short side raised, and
+    the raise carried along the quad strip of a neighbouring four-curve loop."""
+    from curvenet.surfacing.pieces import equalise_pieces
+    # loop 0: bottom = curves 0 (length 2) + 1 (length 1), right 2, top 3, left 4;
+    # loop 1 shares the top (3) with a four-curve loop above: 3, 5, 6, 7 (6 opposite 3)
+    loops = [[(0, True), (1, True), (2, True), (3, True), (4, True)],
+             [(3, False), (5, True), (6, True), (7, True)]]
+    sides = [[[0, 1], [2], [3], [4]], [[0], [1], [2], [3]]]
+    jend = np.array([[0, 1], [1, 2], [2, 3], [3, 4], [4, 0], [3, 5], [5, 6], [6, 4]])
+    lengths = np.array([2.0, 1.0, 1.0, 3.0, 1.0, 1.0, 3.0, 1.0])
+    m = np.array([1, 1, 1, 3, 1, 1, 1, 1])
+    out = equalise_pieces(m, loops, lengths, jend, m, sides=sides)
+    assert out[0] + out[1] == out[3] == 3 and (out[0], out[1]) == (2, 1)
+    assert out[6] == 3                                   # the strip above follows
+    # the other way round: the single top curve takes the bottom's sum
+    m = np.array([2, 2, 1, 1, 1, 1, 1, 1])
+    out = equalise_pieces(m, loops, lengths, jend, m, sides=sides)
+    assert out[3] == out[6] == 4 and out[2] == out[4] == 1
+    # without the sides, nothing is balanced
+    np.testing.assert_array_equal(equalise_pieces(m, loops, lengths, jend, m)[[0, 1, 3]],
+                                  [2, 2, 1])
 
 
 def test_three_sided_and_six_sided_loops_split_around_a_centre():
@@ -189,6 +220,27 @@ def test_a_short_curve_passes_on_no_more_pieces_than_it_has():
     out = equalise_pieces(m, loops, lengths, jend, np.full(len(jend), 200))
     assert out.max() == 2 and out[ids["v", 1, 1]] == 2
 
+
+
+def test_a_curve_split_off_its_middle_keeps_the_grids_and_the_shape():
+    """A meridian of a 3 x 2 torus split at a fifth of its length (where a closed stroke
+    began): its short and long pieces sum to more pieces than the opposite meridian's.
+    Balanced, both loops stay grids and the surface stays on the torus (unbalanced they
+    fell to centre splits, 0.128 off the torus of minor radius 0.4)."""
+    from curvenet.surfacing import surface_loops
+    s = shapes.torus(1.0, 0.4, n_u=3, n_v=2)
+    curves = [e.curve for e in s.network.edges]
+    k = next(i for i, c in enumerate(curves) if np.ptp(c[:, 2]) > 0.1)     # a meridian
+    c, cut, new = curves[k], len(curves[k]) // 5, len(curves)
+    curves[k] = c[:cut + 1]
+    curves.append(c[cut:])
+    loops = [[x for ci, f in lp
+              for x in ((([(ci, f), (new, f)] if f else [(new, f), (ci, f)])) if ci == k
+                        else [(ci, f)])] for lp in s.faces]
+    assert build_control_mesh(curves, loops, 4).patch_kind == ["grid"] * 6
+    V = surface_loops(curves, loops).vertices
+    off = np.abs(np.hypot(np.hypot(V[:, 0], V[:, 1]) - 1.0, V[:, 2]) - 0.4)
+    assert off.max() < 0.02 and np.percentile(off, 90) < 0.005
 
 def test_stroke_wobble_does_not_count_as_winding():
     # a quarter circle turns 90 degrees; a hand-drawn one wobbles (here a smooth offset
