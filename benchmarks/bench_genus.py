@@ -16,7 +16,10 @@ Shapes (all built here or in :mod:`curvenet.datasets`, none tuned one by one):
   random angles (:func:`curvenet.datasets.sections.torus_sections`, 1-2 planes, so 2-4
   rings, and 3-5 meridians; drawn from a seeded generator, never picked one by one:
   rings at least a third of the minor radius apart in height, meridians at least 40
-  degrees apart), each turned, scaled and moved at random in space.
+  degrees apart), each turned, scaled and moved at random in space;
+* ``elliptic``: the same with tubes of elliptic section (half-height 0.5-2 times the
+  half-width, log-uniform; half-width 0.2-0.4), no longer an elementary surface: what
+  the swept patches and the fit must carry between the meridians.
 
 Inputs per shape: ``clean`` (the network's curves as strokes), ``through`` (each
 section drawn as one stroke through its crossings, with a smooth wobble of 0.3% of the
@@ -67,27 +70,31 @@ def cases():
     out.append(("cylinder", shapes.capped_cylinder(n_around=4, n_height=3)))
     out.append(("double torus", sections.double_torus()))
     out.append(("double torus", sections.double_torus(meridians=2, rings=(-0.5, 0.5))))
-    return out + [("uneven", s) for s in uneven_tori(UNEVEN)]
+    return (out + [("uneven", s) for s in uneven_tori(UNEVEN)]
+            + [("elliptic", s) for s in uneven_tori(ELLIPTIC, seed=36, elliptic=True)])
 
 
-#: Uneven tori in the benchmark.
+#: Uneven tori in the benchmark, and uneven tori with elliptic tubes.
 UNEVEN = 12
+ELLIPTIC = 8
 
 
-def uneven_tori(n: int, seed: int = 30):
+def uneven_tori(n: int, seed: int = 30, *, elliptic: bool = False):
     """``n`` tori with unevenly spaced rings and meridians, moved in space (the ``uneven``
-    family; see the module's docstring)."""
+    family; see the module's docstring); ``elliptic``: tubes of elliptic section, the
+    half-height 0.5-2 times the half-width (log-uniform; the ``elliptic`` family)."""
     rng = np.random.default_rng(seed)
     out = []
     while len(out) < n:
-        minor = round(float(rng.uniform(0.2, 0.6)), 2)
+        minor = round(float(rng.uniform(0.2, 0.6 if not elliptic else 0.4)), 2)
+        aspect = round(float(np.exp(rng.uniform(np.log(0.5), np.log(2.0)))), 2) if elliptic else 1
         heights = np.sort(rng.uniform(-0.8, 0.8, int(rng.integers(1, 3))))
         angles = np.sort(rng.uniform(0.0, 360.0, int(rng.integers(3, 6))))
         gaps = np.diff(np.r_[angles, angles[0] + 360.0])
         if np.diff(heights).min(initial=1.0) < 1 / 3 or gaps.min() < 40.0:
             continue
         shape = sections.torus_sections(1.0, minor, heights=tuple(np.round(heights, 2)),
-                                        angles=tuple(np.round(angles)))
+                                        angles=tuple(np.round(angles)), aspect=aspect)
         out.append(_moved(shape, rng))
     return out
 

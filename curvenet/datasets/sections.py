@@ -277,18 +277,22 @@ def capsule(*, radius: float = 0.5, length: float = 1.0, rings: int = 3, meridia
 
 
 def torus_sections(major: float = 1.0, minor: float = 0.4, *, heights=(0.0,),
-                   angles=(0.0, 120.0, 240.0), samples: int = 33) -> AnalyticShape:
+                   angles=(0.0, 120.0, 240.0), aspect: float = 1.0,
+                   samples: int = 33) -> AnalyticShape:
     """A torus around z drawn as horizontal sections and meridians, spaced as given.
 
     Parameters
     ----------
     major, minor : float
-        Radii.
+        Radii (``minor``: the tube's radius across, in the equator's plane).
     heights : sequence of float
-        Heights of the horizontal cutting planes, fractions of ``minor`` in (-1, 1);
-        each plane gives two rings (0: the outer and inner equators).
+        Heights of the horizontal cutting planes, fractions of the tube's half-height
+        in (-1, 1); each plane gives two rings (0: the outer and inner equators).
     angles : sequence of float
         Degrees about z of the meridians (each the section of a half-plane).
+    aspect : float
+        The tube's half-height over ``minor``: 1 a round tube, else an elliptic one
+        (no longer an elementary surface).
     samples : int
         Points per curve.
 
@@ -297,16 +301,29 @@ def torus_sections(major: float = 1.0, minor: float = 0.4, *, heights=(0.0,),
     >>> s = torus_sections(heights=(0.0, 0.7), angles=(0, 90, 180, 270))
     >>> s.network.number_of_edges - s.network.number_of_vertices + 2 - 2 * s.genus
     16
+    >>> e = torus_sections(1.0, 0.2, angles=(0, 120, 240), aspect=2.0)  # a tall tube
+    >>> p = np.concatenate([c.curve for c in e.network.edges])
+    >>> rho = np.hypot(p[:, 0], p[:, 1])
+    >>> bool(np.abs(np.hypot((rho - 1.0) / 0.2, p[:, 2] / 0.4) - 1.0).max() < 1e-3)
+    True
     """
-    planes = [((0, 0, h * minor), (0, 0, 1)) for h in heights]
+    if aspect <= 0:
+        raise ValueError(f"aspect: expected > 0, got {aspect!r}")
+    half = minor * aspect
+    planes = [((0, 0, h * half), (0, 0, 1)) for h in heights]
     for a in np.radians(np.asarray(angles, np.float64)):
         d = np.array([np.cos(a), np.sin(a), 0.0])
         planes.append(((0, 0, 0), (-d[1], d[0], 0.0), lambda c, d=d: float(c @ d) > 0))
     b = major + minor + 0.2 * major
-    name = (f"torus r{minor / major:g} h{','.join(f'{h:g}' for h in heights)} "
-            f"a{','.join(f'{a:g}' for a in angles)}")
-    return _shape(name, torus_sdf((0.0, 0.0, 0.0), major, minor), planes,
-                  ((-b, -b, -minor - 0.2 * major), (b, b, minor + 0.2 * major)), 1, samples)
+    name = (f"torus r{minor / major:g}{f' x{aspect:g}' if aspect != 1 else ''} "
+            f"h{','.join(f'{h:g}' for h in heights)} a{','.join(f'{a:g}' for a in angles)}")
+    F = torus_sdf((0.0, 0.0, 0.0), major, minor)
+    if aspect != 1:
+        def F(p, round_tube=F):       # the round tube's distance with z scaled: same zero set
+            q = np.asarray(p, np.float64) * [1.0, 1.0, 1.0 / aspect]
+            return round_tube(q) * min(1.0, aspect)
+    return _shape(name, F, planes,
+                  ((-b, -b, -half - 0.2 * major), (b, b, half + 0.2 * major)), 1, samples)
 
 
 def double_torus(*, major: float = 1.0, minor: float = 0.35, meridians: int = 3,

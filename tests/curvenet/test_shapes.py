@@ -51,3 +51,20 @@ def test_sketch_has_one_stroke_per_edge():
     s = shapes.box()
     sk = s.sketch()
     assert len(sk) == 12 and set(sk.labels) == {"crease"}
+
+
+def test_elliptic_torus_sections_lie_on_their_tube_and_reference():
+    """``torus_sections(aspect=...)``: the rings and meridians lie on the elliptic tube
+    (half-width ``minor``, half-height ``minor * aspect``), and so does the reference."""
+    from curvenet.datasets import sections
+    s = sections.torus_sections(1.0, 0.2, heights=(0.0, 0.5), angles=(0, 100, 220),
+                                aspect=2.0)
+
+    def off(p):
+        return np.abs(np.hypot((np.hypot(p[:, 0], p[:, 1]) - 1.0) / 0.2, p[:, 2] / 0.4) - 1.0)
+    assert off(np.concatenate([e.curve for e in s.network.edges])).max() < 1e-3
+    # each height plane gives two rings, each meridian one closed curve: 6 + 3 x 4 curves
+    assert s.network.number_of_edges == 2 * 2 * 3 + 3 * 4
+    assert np.median(off(s.reference_mesh(1).vertices)) < 0.02
+    with pytest.raises(ValueError, match="aspect"):
+        sections.torus_sections(aspect=0.0)
