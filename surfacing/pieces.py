@@ -276,14 +276,15 @@ def equalise_pieces(m: np.ndarray, loops: list, lengths: np.ndarray, jend: np.nd
     best = np.zeros(lab.max() + 1 if len(lab) else 0, dtype=np.int64)
     np.maximum.at(best, lab, m)
     length = np.maximum(np.asarray(lengths, np.float64), DIVISION_GUARD)
+    most = np.asarray(most, np.int64)
     pairs = continuations(loops, jend)
-    _raise_continuations(best, lab, pairs, length, np.asarray(most, np.int64))
+    _raise_continuations(best, lab, pairs, length, most)
     split = [[[lp[i][0] for i in g] for g in sd] for lp, sd in zip(loops, sides or [])
              if len(sd) == 4 and any(len(g) > 1 for g in sd)]
     for _ in range(BALANCE_ROUNDS if split else 0):
         if not _balance_sides(best, lab, length, split):
             break
-        _raise_continuations(best, lab, pairs, length, np.asarray(most, np.int64))
+        _raise_continuations(best, lab, pairs, length, most)
     return best[lab]
 
 
