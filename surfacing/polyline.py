@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from curvenet.core.geometry import arc_length, sample_at
+from curvenet.core.geometry import cumulative_length, interpolate_polyline, sample_at
 from curvenet.core.tolerances import DIVISION_GUARD
 
 __all__ = ["end_tangents", "point_polyline_distance"]
@@ -33,11 +33,11 @@ def end_tangents(curve: np.ndarray, fraction: float = 0.1,
         the curve. Zero vectors for a zero-length curve.
     """
     curve = np.asarray(curve, dtype=np.float64)
-    t = np.array([fraction, 1.0 - fraction])
-    if lengths is not None:
-        total = arc_length(curve)
-        t = np.array([lengths[0], total - lengths[1]]) / max(total, DIVISION_GUARD)
-    p = sample_at(curve, t)
+    if lengths is None:
+        p = sample_at(curve, np.array([fraction, 1.0 - fraction]))
+    else:
+        cum = cumulative_length(curve)
+        p = interpolate_polyline(curve, np.array([lengths[0], cum[-1] - lengths[1]]), cum=cum)
     d0, d1 = p[0] - curve[0], p[1] - curve[-1]
     n0, n1 = np.linalg.norm(d0), np.linalg.norm(d1)
     return (d0 / n0 if n0 > 0 else d0), (d1 / n1 if n1 > 0 else d1)
