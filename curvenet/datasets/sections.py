@@ -317,11 +317,10 @@ def torus_sections(major: float = 1.0, minor: float = 0.4, *, heights=(0.0,),
     b = major + minor + 0.2 * major
     name = (f"torus r{minor / major:g}{f' x{aspect:g}' if aspect != 1 else ''} "
             f"h{','.join(f'{h:g}' for h in heights)} a{','.join(f'{a:g}' for a in angles)}")
-    F = torus_sdf((0.0, 0.0, 0.0), major, minor)
-    if aspect != 1:
-        def F(p, round_tube=F):       # the round tube's distance with z scaled: same zero set
-            q = np.asarray(p, np.float64) * [1.0, 1.0, 1.0 / aspect]
-            return round_tube(q) * min(1.0, aspect)
+    round_tube = torus_sdf((0.0, 0.0, 0.0), major, minor)
+
+    def F(p):                   # the round tube's distance with z scaled: the same zero set
+        return round_tube(np.asarray(p, np.float64) * [1.0, 1.0, 1.0 / aspect]) * min(1.0, aspect)
     return _shape(name, F, planes,
                   ((-b, -b, -half - 0.2 * major), (b, b, half + 0.2 * major)), 1, samples)
 
