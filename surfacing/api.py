@@ -250,7 +250,9 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
         corrected to interpolate the samples exactly by the change of least fairness
         energy), keeping the one whose limit surface bends least
         (:func:`surfacing.fit.bending_energy`; within :data:`AUTO_FIT_TIE` of the least,
-        the first of :data:`AUTO_FIT_PREFERENCE`).
+        the first of :data:`AUTO_FIT_PREFERENCE`); where that is ``lsq`` but it departs
+        from the swept shape by more than the shape's two sweeps depart from each other,
+        ``sweep`` (``_sweep_check``; the report's ``sweep_check``).
     update_curves : bool or iterable of int
         Return curves refitted to the surface (Sec. 4.3.3): all when True, else the
         given indices (the others are returned unchanged).
@@ -341,7 +343,8 @@ def _fit_control_net(cm, sharp, *, fit, fairness, curve_weight, lam, tol, max_it
     ``choice`` is the fit used and, for ``auto``, the bending energy of each fit tried
     (``{"fit": ..., "energy": {"lsq": e, "sweep": e or None, "iterative": e or None}}``;
     None: not tried: no swept loop, a control net too large for the iteration, or
-    an iteration that did not reach ``tol`` within its steps).
+    an iteration that did not reach ``tol`` within its steps), and where the energies
+    kept ``lsq`` and a swept fit exists, ``"sweep_check"`` (:func:`_sweep_check`).
     """
     t0 = time.perf_counter()
     sharp_edges, corners = sharp
@@ -395,8 +398,34 @@ def _fit_control_net(cm, sharp, *, fit, fairness, curve_weight, lam, tol, max_it
     if judged:
         least = min(energy[name] for name in judged)
         best = next(name for name in judged if energy[name] <= least * (1.0 + AUTO_FIT_TIE))
-    return _fitted(fits[best], iters[best], L, cons, targets, {"fit": best, "energy": energy},
-                   timings, t0)
+    choice = {"fit": best, "energy": energy}
+    if best == "lsq" and "sweep" in fits:
+        choice["sweep_check"] = _sweep_check(cm, fits["lsq"], fits["sweep"])
+        if choice["sweep_check"]["departure"] > choice["sweep_check"]["spread"]:
+            best = choice["fit"] = "sweep"
+    return _fitted(fits[best], iters[best], L, cons, targets, choice, timings, t0)
+
+
+def _sweep_check(cm, P_lsq, P_sweep) -> dict:
+    """Whether the drawn sections imply their swept shape more firmly than the fairness
+    energy does another: ``{"spread": s, "departure": d}``, fractions of the diagonal.
+
+    ``spread``: the RMS distance between the sweep along ``u`` and the one along ``v``
+    over the control vertices inside the swept loops (``cm.spread``), i.e. how much
+    the swept shape is left open by its sides. ``departure``: the RMS distance there
+    between the least-squares fit and the swept fit. Where the departure is the
+    larger, the least-squares fit moved the surface off a shape that the sections
+    predict, two ways, more alike than that move (a tall elliptic tube drawn as three
+    meridians: the two sweeps agree exactly, the least-squares fit rounds the tube
+    between them); the sweep is kept although it bends more.
+    """
+    inside = np.isfinite(cm.spread)
+    diag = cm.diagonal if cm.diagonal > 0 else 1.0
+    if not inside.any():
+        return {"spread": 0.0, "departure": 0.0}
+    dev = np.linalg.norm(P_lsq[inside] - P_sweep[inside], axis=1)
+    return {"spread": float(np.sqrt(np.mean(cm.spread[inside] ** 2))) / diag,
+            "departure": float(np.sqrt(np.mean(dev ** 2))) / diag}
 
 
 def _iterate(cm, sharp, L, cons, targets, *, lam, tol, steps, vspring_step):
@@ -521,6 +550,9 @@ def explain_fit(report) -> str | None:
     'fit: sweep (bending energy lsq 85.9, sweep 66.6, iterative not tried'
     >>> print(explain_fit({"fit": "lsq"}))
     fit: lsq
+    >>> explain_fit({"fit": "sweep", "energy": {"lsq": 41.5, "sweep": 42.9, "iterative": None},
+    ...              "sweep_check": {"spread": 0.0, "departure": 0.0031}}).split("; ")[-1][:57]
+    'lsq departs from the swept shape by 0.31% of the diagonal'
     """
     if not report or report.get("fit") not in FITS:
         return None
@@ -529,8 +561,14 @@ def explain_fit(report) -> str | None:
         return f"fit: {report['fit']}"
     figures = ", ".join(f"{k} {e:.1f}" if e is not None else f"{k} not tried"
                         for k, e in energy.items())
-    return (f"fit: {report['fit']} (bending energy {figures}; the least kept, ties within "
-            f"{AUTO_FIT_TIE:.0%} going to {', then '.join(AUTO_FIT_PREFERENCE[:2])})")
+    line = (f"fit: {report['fit']} (bending energy {figures}; the least kept, ties within "
+            f"{AUTO_FIT_TIE:.0%} going to {', then '.join(AUTO_FIT_PREFERENCE[:2])}")
+    check = report.get("sweep_check")
+    if check:
+        kept = "sweep" if report["fit"] == "sweep" else "lsq"
+        line += (f"; lsq departs from the swept shape by {check['departure']:.2%} of the "
+                 f"diagonal, its two sweeps by {check['spread']:.2%}: {kept} kept")
+    return line + ")"
 
 
 def soapfilm_loops(curves, loops, *, resolution: int = 16, **_ignored) -> PatchMeshResult:

@@ -88,6 +88,9 @@ class ControlMesh:
         ``vertices`` elsewhere: the rest shape of the ``sweep`` fit.
     swept : (L,) bool
         Loops whose inside ``rest`` sweeps (the ``"grid"`` ones).
+    spread : (n,) float64
+        At the vertices inside the swept loops, the distance between the two sweeps of
+        ``rest`` (along ``u`` and along ``v``: ``sweep_grid``'s ``gap``); NaN elsewhere.
     """
 
     vertices: np.ndarray
@@ -103,6 +106,7 @@ class ControlMesh:
     diagonal: float = 1.0
     rest: np.ndarray | None = None
     swept: np.ndarray | None = None
+    spread: np.ndarray | None = None
 
 
 def _validate(curves, loops):
@@ -329,21 +333,26 @@ def build_control_mesh(curves, loops, resolution: int = 4, *,
     on_curve = np.zeros(len(V), bool)
     on_curve[:n_curve_v] = True
     target = V.copy()
+    rest, spread = _swept_rest(positions, swept)
     return ControlMesh(V, np.concatenate(quads_all).astype(np.int64),
                        np.concatenate(fpatch).astype(np.int64), curve_vids, on_curve, target,
-                       jend, len(jpos), loops, kinds, diag, rest=_swept_rest(positions, swept),
-                       swept=np.array([k == "grid" for k in kinds], bool))
+                       jend, len(jpos), loops, kinds, diag, rest=rest,
+                       swept=np.array([k == "grid" for k in kinds], bool), spread=spread)
 
 
-def _swept_rest(positions, swept) -> np.ndarray:
+def _swept_rest(positions, swept):
     """The control vertices with the insides of the grid loops swept
-    (:func:`.sweep.sweep_grid`), loops of one size at once: ``(n, 3) float64``."""
+    (:func:`.sweep.sweep_grid`), loops of one size at once: ``(n, 3) float64``, and the
+    two sweeps' distance there (``(n,) float64``, NaN outside the swept insides)."""
     rest = list(positions)
+    spread = [np.full(len(block), np.nan) for block in positions]
     for (p, q), items in swept.items():
-        grids = sweep_grid(*(np.stack(side) for side in zip(*(sides for _, sides in items))))
-        for (block, _), grid in zip(items, grids):
+        grids, gaps = sweep_grid(*(np.stack(side) for side in zip(*(sides for _, sides in items))),
+                                 spread=True)
+        for (block, _), grid, gap in zip(items, grids, gaps):
             rest[block] = grid[1:p, 1:q].reshape(-1, 3)
-    return np.concatenate(rest)
+            spread[block] = gap[1:p, 1:q].reshape(-1)
+    return np.concatenate(rest), np.concatenate(spread)
 
 
 def _sample_curves(curves, jend, jpos, k_c):

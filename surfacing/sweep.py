@@ -39,8 +39,9 @@ carried exactly.
 Not in Orbay & Kara 2011, whose control mesh is sampled from the Coons patch: the
 swept grid is the *rest shape* of the ``sweep`` fit (:func:`surfacing.fit.fit_lsq`'s
 ``rest``), which keeps the shape it implies between sparse curves, and the ``auto``
-fit keeps it only where its limit surface bends less than the others
-(:func:`surfacing.fit.bending_energy`). The best rotation from one profile to the other
+fit keeps it where its limit surface bends less than the others
+(:func:`surfacing.fit.bending_energy`), or where the least-squares fit departs from it
+by more than its two sweeps (``spread``) part. The best rotation from one profile to the other
 does not say which way round they turned (meridians of a torus more than half a turn
 apart) or whether they turned at all (a crest that becomes a trough); the rails do, and
 decide it. The corner-numbering convention is :mod:`.coons`'s.
@@ -239,7 +240,7 @@ def transport(A, B, rail0, rail1) -> np.ndarray:
     return out
 
 
-def sweep_grid(bottom, right, top, left) -> np.ndarray:
+def sweep_grid(bottom, right, top, left, *, spread: bool = False):
     """The swept patch of four sides on the grid of their samples.
 
     Parameters
@@ -249,12 +250,20 @@ def sweep_grid(bottom, right, top, left) -> np.ndarray:
         any leading batch shape (several patches of the same size at once).
     right, left : (..., q + 1, 3) float64
         ``c1`` from P10 to P11 and ``c3`` from P00 to P01.
+    spread : bool
+        Also return the distance between the two sweeps.
 
     Returns
     -------
     grid : (..., p + 1, q + 1, 3) float64
         ``grid[..., i, j, :]`` at ``(i / p, j / q)``; its border rows and columns are
         the given sides exactly (bottom and top win at the corners).
+    gap : (..., p + 1, q + 1) float64
+        Only with ``spread``: the distance between the surface swept along ``u`` and
+        the one swept along ``v`` at each grid point (0 on the border). Each predicts
+        the inside from a different pair of sides; where the sides are sections of one
+        surface of revolution they agree exactly, and where the sides imply no
+        consistent sweep they part.
 
     Examples
     --------
@@ -266,6 +275,9 @@ def sweep_grid(bottom, right, top, left) -> np.ndarray:
     >>> g = sweep_grid(arc, arc[-1] + up, arc + [0, 0, 1], arc[0] + up)
     >>> bool(np.allclose(np.hypot(g[..., 0], g[..., 1]), 1))
     True
+    >>> g, gap = sweep_grid(arc, arc[-1] + up, arc + [0, 0, 1], arc[0] + up, spread=True)
+    >>> float(gap.max()) < 1e-12                  # both sweeps are the wall
+    True
     """
     b, r, t, lf = (np.asarray(c, dtype=np.float64) for c in (bottom, right, top, left))
     along_u = transport(lf, r, b, t)                                 # (..., p+1, q+1, 3)
@@ -273,4 +285,9 @@ def sweep_grid(bottom, right, top, left) -> np.ndarray:
     g = 0.5 * (along_u + along_v)
     g[..., 0, :, :], g[..., -1, :, :] = lf, r
     g[..., :, 0, :], g[..., :, -1, :] = b, t
-    return g
+    if not spread:
+        return g
+    gap = np.linalg.norm(along_u - along_v, axis=-1)
+    gap[..., [0, -1], :] = 0.0
+    gap[..., :, [0, -1]] = 0.0
+    return g, gap

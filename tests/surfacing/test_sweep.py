@@ -51,6 +51,27 @@ def test_patches_of_surfaces_of_revolution_are_reproduced(F, u, v):
     assert np.abs(g - truth).max() < 1e-12
 
 
+def test_the_two_sweeps_agree_where_the_sides_imply_one_surface_and_part_elsewhere():
+    """``spread``: the sweep along u and the one along v meet on a surface of revolution
+    (each reproduces it), and part where the four sides are of no one sweep (a patch of
+    a hyperbolic paraboloid whose sides bulge by different amounts)."""
+    F = _torus(1.0, 0.6)
+    u, v = np.linspace(0.2, 1.9, 9), np.linspace(-1.5, 1.5, 7)
+    g, gap = sweep_grid(*_sides(F, u, v), spread=True)
+    assert gap.shape == g.shape[:-1] and gap.max() < 1e-12
+    assert np.array_equal(g, sweep_grid(*_sides(F, u, v)))
+
+    def odd(a, b):
+        a, b = np.broadcast_arrays(np.asarray(a, float), np.asarray(b, float))
+        return np.stack([a, b, a * b + 0.3 * np.sin(np.pi * a) * (1 + 2 * b)
+                         + 0.2 * np.sin(np.pi * b) * a ** 2], -1)
+
+    w = np.linspace(0, 1, 9)
+    _, gap = sweep_grid(*_sides(odd, w, w), spread=True)
+    assert gap[1:-1, 1:-1].max() > 1e-2
+    assert not gap[[0, -1]].any() and not gap[:, [0, -1]].any()
+
+
 def test_the_sides_are_interpolated_exactly_and_a_plane_stays_flat():
     rng = np.random.default_rng(3)
     u, v = np.linspace(0, 1, 8), np.linspace(0, 1, 6)
