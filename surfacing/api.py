@@ -565,9 +565,10 @@ def explain_fit(report) -> str | None:
             f"{AUTO_FIT_TIE:.0%} going to {', then '.join(AUTO_FIT_PREFERENCE[:2])}")
     check = report.get("sweep_check")
     if check:
-        kept = "sweep" if report["fit"] == "sweep" else "lsq"
+        kept = report["fit"] == "sweep"
         line += (f"; lsq departs from the swept shape by {check['departure']:.2%} of the "
-                 f"diagonal, its two sweeps by {check['spread']:.2%}: {kept} kept")
+                 f"diagonal, {'more' if kept else 'no more'} than its two sweeps part "
+                 f"({check['spread']:.2%}): {'sweep' if kept else 'lsq'} kept")
     return line + ")"
 
 
