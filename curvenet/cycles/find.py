@@ -268,6 +268,11 @@ def _face_patches(pool, faces, close: str, max_cycle_length=None) -> list:
     they are independent over GF(2); with ``close="auto"`` the closing rules of
     :func:`~curvenet.cycles.closing.auto_close` then consider the other faces and the
     cycles the basis run enumerated (walls are no faces), up to the longest face kept.
+    A face left out of a closed group counts as long as its sides (:func:`_sides`)
+    allow: where junctions of two curves split its sides, it is the heaviest face but
+    no longer than the others (a torus's face of four sides and six curves, where a
+    closed stroke's ends met on two of them), while the rim of an open sheet or a
+    cup's opening has more sides than any face, and stays open.
     """
     loops = [lp for lp, ok in zip(faces.loops, faces.simple)
              if ok and (max_cycle_length is None or len(lp) <= max_cycle_length)]
@@ -288,17 +293,26 @@ def _face_patches(pool, faces, close: str, max_cycle_length=None) -> list:
         if c.edges not in seen:
             seen.add(c.edges)
             unique.append(c)
-    kept = _independent_faces(unique, pool.n_edges)
+    kept, dropped = _independent_faces(unique, pool.n_edges)
     added = []
     if close == "auto" and kept:
         taken = {id(c) for c in kept}
         rest = [c for c in unique if id(c) not in taken] + pool.all_candidates
-        added = auto_close(pool, [c.edges for c in kept], max(c.length for c in kept),
-                           candidates=rest, faces=seen)
+        degree = np.bincount(np.ravel(ends), minlength=pool.network.number_of_vertices)
+        most = max(_sides(c, degree) for c in kept)
+        longest = max([c.length for c in kept]
+                      + [c.length for c in dropped if _sides(c, degree) <= most])
+        added = auto_close(pool, [c.edges for c in kept], longest, candidates=rest,
+                           faces=seen)
     return [Patch(c.edges, "auto") for c in kept] + [Patch(e, "closing") for e in added]
 
 
-def _independent_faces(faces: list, n_edges: int) -> list:
+def _sides(candidate, degree) -> int:
+    """Sides of a cycle: its junctions of three or more curves (1 where it has none)."""
+    return max(1, int(np.count_nonzero(degree[list(candidate.vertices)] >= 3)))
+
+
+def _independent_faces(faces: list, n_edges: int) -> tuple:
     """The faces less the last of each closed group: a GF(2) independent set.
 
     Each curve bounds at most two faces of an embedding, so a set of them sums to zero
@@ -306,9 +320,11 @@ def _independent_faces(faces: list, n_edges: int) -> list:
     by shared curves, every curve of the group used twice). Each closed group has that
     one relation; dropping its last face (``faces`` is in weight order) leaves the rest
     independent, as the greedy matroid pass would, without an elimination.
+
+    Returns ``(kept, dropped)``: the faces kept and the faces left out.
     """
     if not faces:
-        return []
+        return [], []
     face = np.repeat(np.arange(len(faces)), [c.length for c in faces])
     edge = np.concatenate([c.edges for c in faces])
     uses = np.bincount(edge, minlength=n_edges)
@@ -322,7 +338,8 @@ def _independent_faces(faces: list, n_edges: int) -> list:
     open_group[group[face[uses[edge] != 2]]] = True
     last = {g: i for i, g in enumerate(group.tolist())}    # the heaviest face per group
     drop = {i for g, i in last.items() if not open_group[g]}
-    return [c for i, c in enumerate(faces) if i not in drop]
+    return ([c for i, c in enumerate(faces) if i not in drop],
+            [c for i, c in enumerate(faces) if i in drop])
 
 
 def _covers(patches, others) -> bool:

@@ -27,6 +27,42 @@ def test_sparse_tori_give_exactly_their_faces(m, n, minor):
     assert _found(find_patches(shape.network)) == set(shape.face_edge_sets())
 
 
+def _split(net, edges):
+    """``net`` with each curve of ``edges`` split at its middle sample (a junction of two
+    curves, as where a closed stroke's ends meet)."""
+    out = CurveNetwork(np.array(net.positions))
+    for i, e in enumerate(net.edges):
+        if i not in edges:
+            out.add_edge(e.u, e.v, e.curve, label=e.label)
+            continue
+        k = len(e.curve) // 2
+        mid = out.add_vertex(e.curve[k])
+        out.add_edge(e.u, mid, e.curve[:k + 1], label=e.label)
+        out.add_edge(mid, e.v, e.curve[k:], label=e.label)
+    return out
+
+
+@pytest.mark.parametrize("make", [lambda: shapes.torus(1.0, 0.4, n_u=3, n_v=4),
+                                  lambda: sections.great_circles(3),
+                                  lambda: shapes.capped_cylinder(n_around=4, n_height=3)])
+def test_a_face_split_by_junctions_of_two_curves_is_kept(make):
+    """The faces of a closed surface are one GF(2) relation: the heaviest is left out of
+    the independent set and comes back as the closing patch of the hole it leaves. Two
+    sides of one face split (junctions of two curves, as where a closed stroke's ends
+    met) make it the only face of that many curves; the closing rules looked only as
+    far as the longest face kept and left a hole (a torus, a sphere of three great
+    circles, a capped cylinder: one face short)."""
+    shape = make()
+    faces = [p.edges for p in find_patches(shape.network).patches]   # its faces, tested above
+    face = max(faces, key=len)
+    net = _split(shape.network, set(face[:2]))
+    ps = find_patches(net)
+    uses = np.bincount([e for p in ps.patches for e in p.edges], minlength=net.number_of_edges)
+    assert ps.report["mode"] == "faces"
+    assert len(ps.patches) == len(faces) and (uses == 2).all()
+    assert max(len(p.edges) for p in ps.patches) == len(face) + 2
+
+
 def test_the_basis_alone_caps_the_meridians_of_a_sparse_torus():
     # Abbasinejad's mode: a meridian (2 curves) is shorter than every face (4 curves)
     shape = shapes.torus(n_u=4, n_v=2)
