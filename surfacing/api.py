@@ -416,8 +416,8 @@ def _sweep_check(cm, P_lsq, P_sweep) -> dict:
     between the least-squares fit and the swept fit. Where the departure is the
     larger, the least-squares fit moved the surface off a shape that the sections
     predict, two ways, more alike than that move (a tall elliptic tube drawn as three
-    meridians: the two sweeps agree exactly, the least-squares fit rounds the tube
-    between them); the sweep is kept although it bends more.
+    meridians: the two sweeps agree to the curves' sampling, the least-squares fit
+    rounds the tube between them); the sweep is kept although it bends more.
     """
     inside = np.isfinite(cm.spread)
     diag = cm.diagonal if cm.diagonal > 0 else 1.0

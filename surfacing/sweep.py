@@ -41,10 +41,10 @@ swept grid is the *rest shape* of the ``sweep`` fit (:func:`surfacing.fit.fit_ls
 ``rest``), which keeps the shape it implies between sparse curves, and the ``auto``
 fit keeps it where its limit surface bends less than the others
 (:func:`surfacing.fit.bending_energy`), or where the least-squares fit departs from it
-by more than its two sweeps (``spread``) part. The best rotation from one profile to the other
-does not say which way round they turned (meridians of a torus more than half a turn
-apart) or whether they turned at all (a crest that becomes a trough); the rails do, and
-decide it. The corner-numbering convention is :mod:`.coons`'s.
+by more than its two sweeps (``spread``) part. The best rotation from one profile to
+the other does not say which way round they turned (meridians of a torus more than half
+a turn apart) or whether they turned at all (a crest that becomes a trough); the rails
+do, and decide it. The corner-numbering convention is :mod:`.coons`'s.
 
 References
 ----------
