@@ -400,31 +400,31 @@ def _fit_control_net(cm, sharp, *, fit, fairness, curve_weight, lam, tol, max_it
         best = next(name for name in judged if energy[name] <= least * (1.0 + AUTO_FIT_TIE))
     choice = {"fit": best, "energy": energy}
     if best == "lsq" and "sweep" in fits:
-        choice["sweep_check"] = _sweep_check(cm, fits["lsq"], fits["sweep"])
+        choice["sweep_check"] = _sweep_check(cm.spread, fits["lsq"], fits["sweep"], diag)
         if choice["sweep_check"]["departure"] > choice["sweep_check"]["spread"]:
             best = choice["fit"] = "sweep"
     return _fitted(fits[best], iters[best], L, cons, targets, choice, timings, t0)
 
 
-def _sweep_check(cm, P_lsq, P_sweep) -> dict:
+def _sweep_check(spread, P_lsq, P_sweep, diag: float) -> dict:
     """Whether the drawn sections imply their swept shape more firmly than the fairness
-    energy does another: ``{"spread": s, "departure": d}``, fractions of the diagonal.
+    energy does another: ``{"spread": s, "departure": d}``, fractions of ``diag``.
 
-    ``spread``: the RMS distance between the sweep along ``u`` and the one along ``v``
-    over the control vertices inside the swept loops (``cm.spread``), i.e. how much
-    the swept shape is left open by its sides. ``departure``: the RMS distance there
+    ``spread`` (n,) float64 is :attr:`ControlMesh.spread`, NaN outside the swept loops;
+    ``P_lsq``, ``P_sweep`` (n, 3) float64 the two fits. ``s``: its RMS over the control
+    vertices inside the swept loops, i.e. how much the swept shape is left open by its
+    sides (the sweep along ``u`` against the one along ``v``). ``d``: the RMS distance there
     between the least-squares fit and the swept fit. Where the departure is the
     larger, the least-squares fit moved the surface off a shape that the sections
     predict, two ways, more alike than that move (a tall elliptic tube drawn as three
     meridians: the two sweeps agree to the curves' sampling, the least-squares fit
     rounds the tube between them); the sweep is kept although it bends more.
     """
-    inside = np.isfinite(cm.spread)
-    diag = cm.diagonal if cm.diagonal > 0 else 1.0
+    inside = np.isfinite(spread)
     if not inside.any():
         return {"spread": 0.0, "departure": 0.0}
     dev = np.linalg.norm(P_lsq[inside] - P_sweep[inside], axis=1)
-    return {"spread": float(np.sqrt(np.mean(cm.spread[inside] ** 2))) / diag,
+    return {"spread": float(np.sqrt(np.mean(spread[inside] ** 2))) / diag,
             "departure": float(np.sqrt(np.mean(dev ** 2))) / diag}
 
 
