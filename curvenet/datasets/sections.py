@@ -249,12 +249,17 @@ def _shape(name, F, planes, bounds, genus, samples):
                          reference=lambda s: implicit_mesh(F, bounds, 40 * 2 ** min(s, 3)))
 
 
-def great_circles(n: int = 3, *, radius: float = 1.0, samples: int = 33) -> AnalyticShape:
-    """A sphere drawn as ``n`` great circles (3: the octants; 4: the cuboctahedron's)."""
-    normals = {3: np.eye(3),
-               4: np.array([[1, 1, 1], [1, 1, -1], [1, -1, 1], [-1, 1, 1]], float)}[n]
+def great_circles(n: int = 3, *, normals=None, radius: float = 1.0,
+                  samples: int = 33) -> AnalyticShape:
+    """A sphere drawn as great circles: ``n`` of them (3: the octants; 4: the
+    cuboctahedron's), or one per row of ``normals (k, 3)`` (their planes' normals, in
+    general position: faces of 3 to 5 or more sides, some small)."""
+    if normals is None:
+        normals = {3: np.eye(3),
+                   4: np.array([[1, 1, 1], [1, 1, -1], [1, -1, 1], [-1, 1, 1]], float)}[n]
+    normals = np.asarray(normals, np.float64)
     b = 1.2 * radius
-    return _shape(f"sphere_{n}_circles", lambda p: np.linalg.norm(p, axis=1) - radius,
+    return _shape(f"sphere_{len(normals)}_circles", lambda p: np.linalg.norm(p, axis=1) - radius,
                   [((0, 0, 0), nrm) for nrm in normals], ((-b,) * 3, (b,) * 3), 0, samples)
 
 
@@ -277,7 +282,7 @@ def capsule(*, radius: float = 0.5, length: float = 1.0, rings: int = 3, meridia
 
 
 def torus_sections(major: float = 1.0, minor: float = 0.4, *, heights=(0.0,),
-                   angles=(0.0, 120.0, 240.0), aspect: float = 1.0,
+                   angles=(0.0, 120.0, 240.0), aspect: float = 1.0, tilts=None,
                    samples: int = 33) -> AnalyticShape:
     """A torus around z drawn as horizontal sections and meridians, spaced as given.
 
@@ -293,6 +298,11 @@ def torus_sections(major: float = 1.0, minor: float = 0.4, *, heights=(0.0,),
     aspect : float
         The tube's half-height over ``minor``: 1 a round tube, else an elliptic one
         (no longer an elementary surface).
+    tilts : sequence of (float, float), optional
+        Per horizontal plane, its normal tilted off the axis by the first angle
+        (degrees) towards the direction at the second angle about z (a plane tilted
+        so little that it still meets the tube all round gives two rings that are not
+        circles, and sections whose arcs of the tube differ from meridian to meridian).
     samples : int
         Points per curve.
 
@@ -310,13 +320,18 @@ def torus_sections(major: float = 1.0, minor: float = 0.4, *, heights=(0.0,),
     if aspect <= 0:
         raise ValueError(f"aspect: expected > 0, got {aspect!r}")
     half = minor * aspect
-    planes = [((0, 0, h * half), (0, 0, 1)) for h in heights]
+    tilts = np.radians(np.asarray(tilts if tilts is not None else [(0.0, 0.0)] * len(heights),
+                                  np.float64).reshape(len(heights), 2))
+    planes = [((0, 0, h * half), (np.sin(t) * np.cos(d), np.sin(t) * np.sin(d), np.cos(t)))
+              for h, (t, d) in zip(heights, tilts)]
     for a in np.radians(np.asarray(angles, np.float64)):
         d = np.array([np.cos(a), np.sin(a), 0.0])
         planes.append(((0, 0, 0), (-d[1], d[0], 0.0), lambda c, d=d: float(c @ d) > 0))
     b = major + minor + 0.2 * major
     name = (f"torus r{minor / major:g}{f' x{aspect:g}' if aspect != 1 else ''} "
-            f"h{','.join(f'{h:g}' for h in heights)} a{','.join(f'{a:g}' for a in angles)}")
+            f"h{','.join(f'{h:g}' for h in heights)} a{','.join(f'{a:g}' for a in angles)}"
+            + (f" t{','.join(f'{np.degrees(t):.3g}' for t in tilts[:, 0])}"
+               if tilts.any() else ""))
     round_tube = torus_sdf((0.0, 0.0, 0.0), major, minor)
 
     def F(p):                   # the round tube's distance with z scaled: the same zero set

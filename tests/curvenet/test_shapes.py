@@ -68,3 +68,32 @@ def test_elliptic_torus_sections_lie_on_their_tube_and_reference():
     assert np.median(off(s.reference_mesh(1).vertices)) < 0.02
     with pytest.raises(ValueError, match="aspect"):
         sections.torus_sections(aspect=0.0)
+
+
+def test_tilted_torus_sections_lie_on_the_torus_and_their_planes():
+    """``torus_sections(tilts=...)``: a plane tilted by 6 degrees still cuts the tube all
+    round into two rings, which lie on the torus and in the tilted plane."""
+    from curvenet.datasets import sections
+    s = sections.torus_sections(1.0, 0.4, heights=(0.1,), angles=(0, 100, 200, 290),
+                                tilts=[(6.0, 30.0)])
+    p = np.concatenate([e.curve for e in s.network.edges])
+    assert np.abs(np.hypot(np.hypot(p[:, 0], p[:, 1]) - 1.0, p[:, 2]) - 0.4).max() < 1e-3
+    t, d = np.radians(6.0), np.radians(30.0)
+    n = np.array([np.sin(t) * np.cos(d), np.sin(t) * np.sin(d), np.cos(t)])
+    ring = np.abs(p @ n - 0.1 * 0.4 * np.cos(t)) < 1e-6     # through (0, 0, 0.1 x 0.4)
+    assert ring.sum() > 0.3 * len(p)              # the ring samples, in the plane
+    assert s.network.number_of_edges == 2 * 4 + 4 * 2   # 2 rings in 4, 4 meridians in 2
+    assert s.name.endswith(" t6")
+
+
+def test_great_circles_in_general_position():
+    """``great_circles(normals=...)``: k circles in general position cross in k (k - 1)
+    junctions of four curves, and bound k (k - 1) + 2 faces."""
+    from curvenet.datasets import sections
+    normals = np.random.default_rng(7).normal(size=(5, 3))
+    s = sections.great_circles(normals=normals)
+    net = s.network
+    assert (net.number_of_vertices, net.number_of_edges) == (20, 40)
+    p = np.concatenate([e.curve for e in net.edges])
+    assert np.abs(np.linalg.norm(p, axis=1) - 1.0).max() < 1e-3
+    assert s.name == "sphere_5_circles"
