@@ -20,6 +20,12 @@ Shapes (all built here or in :mod:`curvenet.datasets`, none tuned one by one):
 * ``elliptic``: the same with tubes of elliptic section (half-height 0.5-2 times the
   half-width, log-uniform; half-width 0.2-0.4), no longer an elementary surface: what
   the swept patches and the fit must carry between the meridians.
+* ``tilted``: the ``uneven`` tori with each cutting plane tilted off the axis towards a
+  random direction, by up to the most that still meets the tube all round (rings that
+  are not circles; sections whose arcs of the tube differ from meridian to meridian).
+* ``circles``: spheres from 5 and 6 great circles in general position (random normals,
+  any two at least 20 degrees apart): faces of 3 to 6 sides, some small, where three
+  circles nearly meet.
 
 Inputs per shape: ``clean`` (the network's curves as strokes), ``through`` (each
 section drawn as one stroke through its crossings, with a smooth wobble of 0.3% of the
@@ -71,18 +77,42 @@ def cases():
     out.append(("double torus", sections.double_torus()))
     out.append(("double torus", sections.double_torus(meridians=2, rings=(-0.5, 0.5))))
     return (out + [("uneven", s) for s in uneven_tori(UNEVEN)]
-            + [("elliptic", s) for s in uneven_tori(ELLIPTIC, seed=36, elliptic=True)])
+            + [("elliptic", s) for s in uneven_tori(ELLIPTIC, seed=36, elliptic=True)]
+            + [("tilted", s) for s in uneven_tori(TILTED, seed=41, tilted=True)]
+            + [("circles", s) for s in general_circles((5, 5, 6))])
 
 
-#: Uneven tori in the benchmark, and uneven tori with elliptic tubes.
+#: Uneven tori in the benchmark, uneven tori with elliptic tubes, with tilted planes.
 UNEVEN = 12
 ELLIPTIC = 8
+TILTED = 8
 
 
-def uneven_tori(n: int, seed: int = 30, *, elliptic: bool = False):
+def general_circles(counts, seed: int = 44):
+    """Spheres drawn as great circles in general position, one per count (the
+    ``circles`` family), moved in space."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for i, k in enumerate(counts):
+        while True:
+            nrm = rng.normal(size=(k, 3))
+            nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
+            cos = np.abs(nrm @ nrm.T)[np.triu_indices(k, 1)]
+            if np.degrees(np.arccos(cos.max())) >= 20.0:
+                break
+        shape = sections.great_circles(normals=nrm)
+        shape.name = f"sphere {k} circles #{i}"
+        out.append(_moved(shape, rng))
+    return out
+
+
+def uneven_tori(n: int, seed: int = 30, *, elliptic: bool = False, tilted: bool = False):
     """``n`` tori with unevenly spaced rings and meridians, moved in space (the ``uneven``
     family; see the module's docstring); ``elliptic``: tubes of elliptic section, the
-    half-height 0.5-2 times the half-width (log-uniform; the ``elliptic`` family)."""
+    half-height 0.5-2 times the half-width (log-uniform; the ``elliptic`` family);
+    ``tilted``: each plane tilted by a random fraction (0.3-1) of the most that keeps it
+    within 0.9 of the tube's half-height all round, and the planes at least a third of
+    it apart all over the torus (the ``tilted`` family)."""
     rng = np.random.default_rng(seed)
     out = []
     while len(out) < n:
@@ -93,8 +123,21 @@ def uneven_tori(n: int, seed: int = 30, *, elliptic: bool = False):
         gaps = np.diff(np.r_[angles, angles[0] + 360.0])
         if np.diff(heights).min(initial=1.0) < 1 / 3 or gaps.min() < 40.0:
             continue
+        tilts = None
+        if tilted:              # slope of each plane over the torus's outer radius
+            reach = 1.0 + minor
+            top = np.degrees(np.arctan((0.9 - np.abs(heights)) * minor / reach))
+            tilts = np.c_[np.round(top * rng.uniform(0.3, 1.0, len(heights)), 1),
+                          np.round(rng.uniform(0.0, 360.0, len(heights)))]
+            t = np.radians(tilts)
+            grad = np.tan(t[:, :1]) * np.c_[np.cos(t[:, 1]), np.sin(t[:, 1])]
+            if len(heights) == 2 and (abs(heights[1] - heights[0]) * minor
+                                      - reach * np.linalg.norm(grad[1] - grad[0])
+                                      < minor / 3):
+                continue
         shape = sections.torus_sections(1.0, minor, heights=tuple(np.round(heights, 2)),
-                                        angles=tuple(np.round(angles)), aspect=aspect)
+                                        angles=tuple(np.round(angles)), aspect=aspect,
+                                        tilts=tilts)
         out.append(_moved(shape, rng))
     return out
 
