@@ -252,8 +252,8 @@ def _shape(name, F, planes, bounds, genus, samples):
 def great_circles(n: int = 3, *, normals=None, radius: float = 1.0,
                   samples: int = 33) -> AnalyticShape:
     """A sphere drawn as great circles: ``n`` of them (3: the octants; 4: the
-    cuboctahedron's), or one per row of ``normals (k, 3)`` (their planes' normals, in
-    general position: faces of 3 to 5 or more sides, some small)."""
+    cuboctahedron's), or one per row of ``normals (k, 3)`` (their planes' normals; in
+    general position the faces have three or more sides, some small)."""
     if normals is None:
         normals = {3: np.eye(3),
                    4: np.array([[1, 1, 1], [1, 1, -1], [1, -1, 1], [-1, 1, 1]], float)}[n]
@@ -320,8 +320,11 @@ def torus_sections(major: float = 1.0, minor: float = 0.4, *, heights=(0.0,),
     if aspect <= 0:
         raise ValueError(f"aspect: expected > 0, got {aspect!r}")
     half = minor * aspect
-    tilts = np.radians(np.asarray(tilts if tilts is not None else [(0.0, 0.0)] * len(heights),
-                                  np.float64).reshape(len(heights), 2))
+    tilts = np.asarray(tilts if tilts is not None else [(0.0, 0.0)] * len(heights), np.float64)
+    if tilts.shape != (len(heights), 2):
+        raise ValueError(f"tilts: expected one (angle, direction) per height, got shape "
+                         f"{tilts.shape} for {len(heights)} heights")
+    tilts = np.radians(tilts)
     planes = [((0, 0, h * half), (np.sin(t) * np.cos(d), np.sin(t) * np.sin(d), np.cos(t)))
               for h, (t, d) in zip(heights, tilts)]
     for a in np.radians(np.asarray(angles, np.float64)):

@@ -84,6 +84,8 @@ def test_tilted_torus_sections_lie_on_the_torus_and_their_planes():
     assert ring.sum() > 0.3 * len(p)              # the ring samples, in the plane
     assert s.network.number_of_edges == 2 * 4 + 4 * 2   # 2 rings in 4, 4 meridians in 2
     assert s.name.endswith(" t6")
+    with pytest.raises(ValueError, match="tilts"):
+        sections.torus_sections(heights=(0.0, 0.5), tilts=[(6.0, 30.0)])
 
 
 def test_great_circles_in_general_position():
