@@ -334,7 +334,7 @@ def torus_sections(major: float = 1.0, minor: float = 0.4, *, heights=(0.0,),
     name = (f"torus r{minor / major:g}{f' x{aspect:g}' if aspect != 1 else ''} "
             f"h{','.join(f'{h:g}' for h in heights)} a{','.join(f'{a:g}' for a in angles)}"
             + (f" t{','.join(f'{np.degrees(t):.3g}' for t in tilts[:, 0])}"
-               if tilts.any() else ""))
+               if tilts[:, 0].any() else ""))
     round_tube = torus_sdf((0.0, 0.0, 0.0), major, minor)
 
     def F(p):                   # the round tube's distance with z scaled: the same zero set
