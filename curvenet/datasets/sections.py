@@ -24,6 +24,8 @@ Examples
 
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
 from scipy.spatial import cKDTree
 
@@ -161,22 +163,24 @@ def section_network(F, planes, bounds, *, cells: int = SECTION_CELLS,
     net = CurveNetwork(np.array([pts[inv == j].mean(axis=0) for j in np.flatnonzero(shared)])
                        .reshape(-1, 3))
     offset = 0
-    for (_, poly, closed), c in zip(traced, cuts):
+    for (k, poly, closed), c in zip(traced, cuts):
         groups = inv[offset:offset + len(c)]
         offset += len(c)
         ok = shared[groups]
+        # resampled points lie on the traced polyline's chords: put them back on F = 0
         _split(net, poly, closed, [x for x, keep in zip(c, ok) if keep], index[groups[ok]],
-               samples)
+               samples, partial(_onto, F, h=h, normal=frames[k][0]))
     return net
 
 
-def _split(net, poly, closed, cuts, ids, samples):
-    """Add one section's curves to ``net``, cut at its junctions."""
+def _split(net, poly, closed, cuts, ids, samples, onto):
+    """Add one section's curves to ``net``, cut at its junctions; ``onto`` moves points
+    ``(n, 3)`` back onto the surface within the section's plane."""
     from ..core.geometry import cumulative_length
     if not cuts:
         if closed:
             v = net.add_vertex(poly[0])
-            net.add_edge(v, v, _resample(poly, samples))
+            net.add_edge(v, v, _resample(poly, samples, onto))
         return
     cum = cumulative_length(poly)
     seg = np.array([s for s, _ in cuts])
@@ -198,14 +202,14 @@ def _split(net, poly, closed, cuts, ids, samples):
         inner = poly2[(cum2 > a) & (cum2 < b)]
         piece = np.concatenate([net.positions[u][None], inner, net.positions[v][None]])
         if len(piece) >= 2 and cumulative_length(piece)[-1] > 0:
-            net.add_edge(int(u), int(v), _resample(piece, samples))
+            net.add_edge(int(u), int(v), _resample(piece, samples, onto))
 
 
-def _resample(poly, samples):
+def _resample(poly, samples, onto):
     if samples is None:
         return poly
     from ..core.geometry import resample_polyline
-    out = resample_polyline(poly, samples - 1)
+    out = onto(resample_polyline(poly, samples - 1))
     out[0], out[-1] = poly[0], poly[-1]
     return out
 

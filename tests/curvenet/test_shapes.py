@@ -77,7 +77,8 @@ def test_tilted_torus_sections_lie_on_the_torus_and_their_planes():
     s = sections.torus_sections(1.0, 0.4, heights=(0.1,), angles=(0, 100, 200, 290),
                                 tilts=[(6.0, 30.0)])
     p = np.concatenate([e.curve for e in s.network.edges])
-    assert np.abs(np.hypot(np.hypot(p[:, 0], p[:, 1]) - 1.0, p[:, 2]) - 0.4).max() < 1e-3
+    # on the torus to round-off: resampled points are put back on it, not left on chords
+    assert np.abs(np.hypot(np.hypot(p[:, 0], p[:, 1]) - 1.0, p[:, 2]) - 0.4).max() < 1e-9
     t, d = np.radians(6.0), np.radians(30.0)
     n = np.array([np.sin(t) * np.cos(d), np.sin(t) * np.sin(d), np.cos(t)])
     ring = np.abs(p @ n - 0.1 * 0.4 * np.cos(t)) < 1e-6     # through (0, 0, 0.1 x 0.4)
