@@ -52,6 +52,10 @@ MAX_RADIUS = 10.0
 #: A curve is straight (a ruling) when its points lie this close to its chord, and a
 #: circular arc when they lie this close to a circle (fractions of the curve's extent).
 CURVE_TOL = 1e-6
+#: Curves this close to a circle (fraction of their extent) give first guesses of a
+#: torus's axis (:func:`_meridian_axes`); the refined surface is judged by the patch's
+#: own tolerance.
+GUESS_CURVE_TOL = 1e-3
 #: Cosine above which two axis guesses count as the same direction.
 SAME_AXIS = 1.0 - 1e-9
 #: Parameters that fix a surface of each kind (a cylinder: its axis line 4 and its
@@ -406,8 +410,9 @@ def _axis_guesses(p, shapes) -> list:
     return uniq, arcs
 
 
-def _candidates(kind, p, axes, arcs):
-    """First guesses of one kind's parameter vector."""
+def _candidates(kind, p, axes, arcs, near=()):
+    """First guesses of one kind's parameter vector (``near``: the curves' circles within
+    :data:`GUESS_CURVE_TOL`, for the torus's axis)."""
     if kind == "sphere":
         g = _guess_sphere(p)
         return [] if g is None else [g]
@@ -415,8 +420,29 @@ def _candidates(kind, p, axes, arcs):
         return [g for g in (_guess_cylinder(p, a) for a in axes) if g is not None]
     if kind == "cone":
         return [g for g in (_guess_cone(p, a) for a in axes) if g is not None]
-    lines = [(c, n) for c, n, _ in arcs] + [(p.mean(axis=0), a) for a in axes]
+    lines = [(c, n) for c, n, _ in arcs] + _meridian_axes(near) + [(p.mean(axis=0), a)
+                                                                   for a in axes]
     return [g for g in (_guess_torus(p, _unit(n), c) for c, n in lines) if g is not None]
+
+
+def _meridian_axes(arcs) -> list:
+    """Axis lines ``(point, direction)`` where the planes of two arcs meet.
+
+    Two meridians of a torus lie in planes through its axis, so their planes meet in it,
+    whatever the other curves of the boundary are (rings cut by tilted planes are no
+    circles, and their arcs give no axis). A ring's arc gives its axis itself
+    (:func:`_candidates`); arcs in parallel planes meet nowhere and give none.
+    """
+    out = []
+    for i, (c1, n1, _) in enumerate(arcs):
+        for c2, n2, _ in arcs[i + 1:]:
+            d = np.cross(n1, n2)
+            if np.linalg.norm(d) < 1.0 - SAME_AXIS:
+                continue
+            d = _unit(d)
+            M = np.stack([n1, n2, d])
+            out.append((np.linalg.solve(M, [n1 @ c1, n2 @ c2, d @ (c1 + c2) / 2.0]), d))
+    return out
 
 
 def fit_analytic(curves, *, tol: float, diagonal: float, kinds=KINDS, loops=None):
@@ -471,8 +497,10 @@ def fit_analytic(curves, *, tol: float, diagonal: float, kinds=KINDS, loops=None
         if axes is None:
             shapes = _shapes(curves)
             axes, arcs = _axis_guesses(p, shapes)
+        near = [] if kind != "torus" else [
+            a for a in (fit_circle(cv, tol=GUESS_CURVE_TOL) for cv in curves) if a is not None]
         best = None
-        for x, res in _refined(kind, p, _candidates(kind, p, axes, arcs), tol):
+        for x, res in _refined(kind, p, _candidates(kind, p, axes, arcs, near), tol):
             if best is None or res < best[1]:
                 best = (x, res)
         if best is not None and best[1] <= tol:

@@ -165,6 +165,43 @@ def test_a_torus_that_crosses_itself_is_refused():
     assert got is not None and got.radius == pytest.approx(3.0, rel=1e-9)
     assert fit_analytic(_torus_patch(0.3), tol=1e-9, diagonal=3.0, kinds=("torus",)) is None
 
+def _tilted_ring(phi, R, r, height, tilt, towards, psi):
+    """Tube angles ``psi (n,)`` where the plane ``z = height + tan(tilt) x . (cos towards,
+    sin towards)`` cuts the meridians at ``phi (n,)`` (Newton from ``psi``)."""
+    k, c = np.tan(tilt), np.cos(phi - towards)
+    for _ in range(60):
+        g = r * np.sin(psi) - height - k * (R + r * np.cos(psi)) * c
+        psi = psi - g / (r * np.cos(psi) + k * r * np.sin(psi) * c)
+    return psi
+
+
+@pytest.mark.parametrize("span, tilt", [(130.0, 7.0), (190.0, 3.0)])
+def test_a_torus_face_between_meridians_and_rings_of_tilted_planes(span, tilt):
+    """Two meridian arcs and two rings cut by tilted planes, which are no circles: the
+    meridians' planes meet in the axis, and the face is found to be the torus in any
+    frame (the first was refused when only the arcs' own axes and the principal axes
+    were tried)."""
+    R, r = 1.0, 0.43
+    phi = np.linspace(0.0, np.radians(span), 33)
+
+    def on_torus(f, p):
+        return np.c_[(R + r * np.cos(p)) * np.cos(f), (R + r * np.cos(p)) * np.sin(f),
+                     r * np.sin(p)]
+    t = np.radians(tilt)
+    low = _tilted_ring(phi, R, r, -0.1, t, 0.3, np.full_like(phi, -0.3))
+    high = _tilted_ring(phi, R, r, 0.25, t, 2.0, np.full_like(phi, 1.0))
+    v = np.linspace(0.0, 1.0, 17)
+    curves = [on_torus(phi, low),
+              on_torus(np.full_like(v, phi[-1]), low[-1] + v * (high[-1] - low[-1])),
+              on_torus(phi, high)[::-1],
+              on_torus(np.zeros_like(v), high[0] + v * (low[0] - high[0]))]
+    assert [fit_circle(c) is not None for c in curves] == [False, True, False, True]
+    moved, scale = _moved(curves)
+    got = fit_analytic(moved, tol=1e-7 * scale, diagonal=3.0 * scale)
+    assert got is not None and got.kind == "torus"
+    assert (got.radius, got.minor) == pytest.approx((R * scale, r * scale), rel=1e-6)
+
+
 @pytest.mark.parametrize("name", ["cylinder", "cone", "sphere", "torus"])
 def test_projection_lands_on_the_surface_and_is_closest(name):
     curves, _ = FACES[name]
