@@ -16,8 +16,9 @@ fit in the plane normal to an axis for cylinders, its linear extension with a ra
 linear in height for cones, and its meridian-section form for tori; the linear
 sphere fit), then a Levenberg-Marquardt refinement of the geometric distance. Axis
 guesses come from the boundary itself: the directions of its straight curves (a
-cylinder's rulings), the normals of its circular arcs (circles of revolution), and
-its principal directions.
+cylinder's rulings), the normals of its circular arcs (circles of revolution), its
+principal directions, and for tori the lines where two arcs' planes meet (two meridians'
+planes meet in the axis, whatever the boundary's other curves are).
 
 Arrays in, arrays out: this module knows no graph and no CAD kernel.
 
