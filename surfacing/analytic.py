@@ -40,6 +40,8 @@ import numpy as np
 from curvenet.core.geometry import bbox_diagonal, fit_plane
 from curvenet.core.tolerances import DIVISION_GUARD
 
+from .arcs import fit_circle, in_axis_frame, normal_to, straight, unit
+
 __all__ = ["AnalyticSurface", "fit_analytic", "fit_circle", "KINDS", "ANALYTIC_TOL",
            "MAX_RADIUS", "FREEDOMS", "in_axis_frame"]
 
@@ -50,9 +52,6 @@ KINDS = ("plane", "cylinder", "cone", "sphere", "torus")
 ANALYTIC_TOL = 1e-5
 #: Largest radius (cylinder, cone base, sphere, torus) of a fitted surface, in diagonals.
 MAX_RADIUS = 10.0
-#: A curve is straight (a ruling) when its points lie this close to its chord, and a
-#: circular arc when they lie this close to a circle (fractions of the curve's extent).
-CURVE_TOL = 1e-6
 #: Curves this close to a circle (fraction of their extent) give first guesses of a
 #: torus's axis (:func:`_meridian_axes`); the refined surface is judged by the patch's
 #: own tolerance.
@@ -180,83 +179,15 @@ class AnalyticSurface:
                    float(d["radius"]), float(d["minor"]), float(d["residual"]))
 
 
-# --------------------------------------------------------------------------- frames
-def _unit(v) -> np.ndarray:
-    v = np.asarray(v, np.float64)
-    return v / max(float(np.linalg.norm(v)), DIVISION_GUARD)
-
-
-def _normal_to(axis) -> np.ndarray:
-    """A unit vector normal to ``axis``."""
-    a = _unit(axis)
-    e = np.eye(3)[int(np.argmin(np.abs(a)))]
-    return _unit(e - (e @ a) * a)
-
-
+# --------------------------------------------------------------------------- angles
 def _angles(axis) -> np.ndarray:
     """Polar angles ``(theta, phi)`` of a unit vector."""
-    a = _unit(axis)
+    a = unit(axis)
     return np.array([np.arccos(np.clip(a[2], -1.0, 1.0)), np.arctan2(a[1], a[0])])
 
 
 def _from_angles(theta, phi) -> np.ndarray:
     return np.array([np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi), np.cos(theta)])
-
-
-def in_axis_frame(points, axis, origin):
-    """Coordinates ``x, y, z`` ((n,) float64 each) of points (n, 3) in a frame with ``z``
-    along the unit ``axis`` from ``origin``, and the frame's ``e1, e2`` ((3,) each)."""
-    e1 = _normal_to(axis)
-    e2 = np.cross(axis, e1)
-    d = np.asarray(points) - origin
-    return d @ e1, d @ e2, d @ axis, e1, e2
-
-
-def fit_circle(points, *, tol: float = CURVE_TOL):
-    """The circle a curve's points lie on, if they do.
-
-    Parameters
-    ----------
-    points : (n, 3) float64
-    tol : float
-        Largest distance to the circle (and to its plane), fraction of the points'
-        extent.
-
-    Returns
-    -------
-    (centre (3,), normal (3,), radius) or None
-        None for straight, non-planar or non-circular points, or fewer than 3.
-    """
-    p = np.asarray(points, np.float64)
-    if len(p) < 3:
-        return None
-    ext = bbox_diagonal(p)
-    c, n, _ = fit_plane(p)
-    if ext <= 0 or np.abs((p - c) @ n).max() > tol * ext:
-        return None
-    x, y, _, e1, e2 = in_axis_frame(p, n, c)
-    A = np.c_[2 * x, 2 * y, np.ones_like(x)]
-    sol, *_ = np.linalg.lstsq(A, x * x + y * y, rcond=None)
-    r2 = sol[2] + sol[0] ** 2 + sol[1] ** 2
-    if not r2 > 0:
-        return None
-    r = float(np.sqrt(r2))
-    centre = c + sol[0] * e1 + sol[1] * e2
-    if np.abs(np.hypot(x - sol[0], y - sol[1]) - r).max() > tol * ext or r > 1e3 * ext:
-        return None
-    return centre, n, r
-
-
-def _straight(points, tol: float = CURVE_TOL):
-    """Unit direction of a straight curve, or None."""
-    p = np.asarray(points, np.float64)
-    d = p[-1] - p[0]
-    L = float(np.linalg.norm(d))
-    if L <= 0:
-        return None
-    u = d / L
-    off = (p - p[0]) - np.outer((p - p[0]) @ u, u)
-    return u if np.linalg.norm(off, axis=1).max() <= tol * L else None
 
 
 # --------------------------------------------------------------------------- first guesses
@@ -322,11 +253,11 @@ def _surface(kind, x, residual=0.0) -> AnalyticSurface:
     o = np.asarray(x[2:5], np.float64)
     if kind == "cylinder":
         o = o - (o @ axis) * axis
-        return AnalyticSurface(kind, o, axis, _normal_to(axis), abs(float(x[5])), 0.0, residual)
+        return AnalyticSurface(kind, o, axis, normal_to(axis), abs(float(x[5])), 0.0, residual)
     if kind == "cone":
-        return AnalyticSurface(kind, o, axis, _normal_to(axis), float(x[5]), float(x[6]),
+        return AnalyticSurface(kind, o, axis, normal_to(axis), float(x[5]), float(x[6]),
                                residual)
-    return AnalyticSurface(kind, o, axis, _normal_to(axis), abs(float(x[5])), abs(float(x[6])),
+    return AnalyticSurface(kind, o, axis, normal_to(axis), abs(float(x[5])), abs(float(x[6])),
                            residual)
 
 
@@ -391,7 +322,7 @@ def _shapes(curves) -> list:
     radius))`` when it lies on a circle (:func:`fit_circle`), else ``(None, None)``."""
     out = []
     for c in curves:
-        u = _straight(c)
+        u = straight(c)
         out.append((u, None if u is not None else fit_circle(c)))
     return out
 
@@ -405,7 +336,7 @@ def _axis_guesses(p, shapes) -> list:
     out += list(np.linalg.svd(p - p.mean(axis=0), full_matrices=False)[2])
     uniq = []
     for a in out:
-        a = _unit(a)
+        a = unit(a)
         if not any(abs(a @ b) > SAME_AXIS for b in uniq):
             uniq.append(a)
     return uniq, arcs
@@ -423,7 +354,7 @@ def _candidates(kind, p, axes, arcs, near=()):
         return [g for g in (_guess_cone(p, a) for a in axes) if g is not None]
     lines = [(c, n) for c, n, _ in arcs] + _meridian_axes(near) + [(p.mean(axis=0), a)
                                                                    for a in axes]
-    return [g for g in (_guess_torus(p, _unit(n), c) for c, n in lines) if g is not None]
+    return [g for g in (_guess_torus(p, unit(n), c) for c, n in lines) if g is not None]
 
 
 def _meridian_axes(arcs) -> list:
@@ -440,7 +371,7 @@ def _meridian_axes(arcs) -> list:
             d = np.cross(n1, n2)
             if np.linalg.norm(d) < 1.0 - SAME_AXIS:
                 continue
-            d = _unit(d)
+            d = unit(d)
             M = np.stack([n1, n2, d])
             out.append((np.linalg.solve(M, [n1 @ c1, n2 @ c2, d @ (c1 + c2) / 2.0]), d))
     return out
@@ -493,7 +424,7 @@ def fit_analytic(curves, *, tol: float, diagonal: float, kinds=KINDS, loops=None
         if kind == "plane":
             res = float(np.abs((p - c) @ n).max())
             if res <= tol:
-                return AnalyticSurface("plane", c, _unit(n), _normal_to(n), 0.0, 0.0, res)
+                return AnalyticSurface("plane", c, unit(n), normal_to(n), 0.0, 0.0, res)
             continue
         if axes is None:
             shapes = _shapes(curves)

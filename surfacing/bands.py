@@ -18,7 +18,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .analytic import AnalyticSurface, in_axis_frame, fit_circle
+from .analytic import AnalyticSurface
+from .arcs import fit_circle, in_axis_frame
 from .flat import replace_faces
 
 __all__ = ["band_frame", "mesh_bands"]

@@ -1,0 +1,88 @@
+"""Circles and lines that a curve's samples lie on, and frames about an axis.
+
+The analytic faces (:mod:`.analytic`) read a boundary's curves first: a straight curve
+gives a cylinder's ruling, a circular arc an axis of revolution, and bands of revolution
+(:mod:`.bands`) are meshed in the frame of their axis.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from curvenet.core.geometry import bbox_diagonal, fit_plane
+from curvenet.core.tolerances import DIVISION_GUARD
+
+__all__ = ["CURVE_TOL", "fit_circle", "straight", "in_axis_frame", "normal_to", "unit"]
+
+#: A curve is straight (a ruling) when its points lie this close to its chord, and a
+#: circular arc when they lie this close to a circle (fractions of the curve's extent).
+CURVE_TOL = 1e-6
+
+
+def unit(v) -> np.ndarray:
+    """``v`` scaled to length 1 (unchanged where it is zero)."""
+    v = np.asarray(v, np.float64)
+    return v / max(float(np.linalg.norm(v)), DIVISION_GUARD)
+
+
+def normal_to(axis) -> np.ndarray:
+    """A unit vector normal to ``axis``."""
+    a = unit(axis)
+    e = np.eye(3)[int(np.argmin(np.abs(a)))]
+    return unit(e - (e @ a) * a)
+
+
+def in_axis_frame(points, axis, origin):
+    """Coordinates ``x, y, z`` ((n,) float64 each) of points (n, 3) in a frame with ``z``
+    along the unit ``axis`` from ``origin``, and the frame's ``e1, e2`` ((3,) each)."""
+    e1 = normal_to(axis)
+    e2 = np.cross(axis, e1)
+    d = np.asarray(points) - origin
+    return d @ e1, d @ e2, d @ axis, e1, e2
+
+
+def fit_circle(points, *, tol: float = CURVE_TOL):
+    """The circle a curve's points lie on, if they do.
+
+    Parameters
+    ----------
+    points : (n, 3) float64
+    tol : float
+        Largest distance to the circle (and to its plane), fraction of the points'
+        extent.
+
+    Returns
+    -------
+    (centre (3,), normal (3,), radius) or None
+        None for straight, non-planar or non-circular points, or fewer than 3.
+    """
+    p = np.asarray(points, np.float64)
+    if len(p) < 3:
+        return None
+    ext = bbox_diagonal(p)
+    c, n, _ = fit_plane(p)
+    if ext <= 0 or np.abs((p - c) @ n).max() > tol * ext:
+        return None
+    x, y, _, e1, e2 = in_axis_frame(p, n, c)
+    A = np.c_[2 * x, 2 * y, np.ones_like(x)]
+    sol, *_ = np.linalg.lstsq(A, x * x + y * y, rcond=None)
+    r2 = sol[2] + sol[0] ** 2 + sol[1] ** 2
+    if not r2 > 0:
+        return None
+    r = float(np.sqrt(r2))
+    centre = c + sol[0] * e1 + sol[1] * e2
+    if np.abs(np.hypot(x - sol[0], y - sol[1]) - r).max() > tol * ext or r > 1e3 * ext:
+        return None
+    return centre, n, r
+
+
+def straight(points, tol: float = CURVE_TOL):
+    """Unit direction of a straight curve, or None."""
+    p = np.asarray(points, np.float64)
+    d = p[-1] - p[0]
+    L = float(np.linalg.norm(d))
+    if L <= 0:
+        return None
+    u = d / L
+    off = (p - p[0]) - np.outer((p - p[0]) @ u, u)
+    return u if np.linalg.norm(off, axis=1).max() <= tol * L else None
