@@ -40,7 +40,7 @@ import numpy as np
 from curvenet.core.geometry import bbox_diagonal, fit_plane
 from curvenet.core.tolerances import DIVISION_GUARD
 
-from .arcs import fit_circle, in_axis_frame, normal_to, straight, unit
+from .arcs import fit_circle, in_axis_frame, kasa, normal_to, straight, unit
 
 __all__ = ["AnalyticSurface", "fit_analytic", "fit_circle", "KINDS", "ANALYTIC_TOL",
            "MAX_RADIUS", "FREEDOMS", "in_axis_frame"]
@@ -191,18 +191,10 @@ def _from_angles(theta, phi) -> np.ndarray:
 
 
 # --------------------------------------------------------------------------- first guesses
-def _kasa(x, y):
-    """Linear circle fit: ``(cx, cy, r)`` or None."""
-    A = np.c_[2 * x, 2 * y, np.ones_like(x)]
-    sol, *_ = np.linalg.lstsq(A, x * x + y * y, rcond=None)
-    r2 = sol[2] + sol[0] ** 2 + sol[1] ** 2
-    return (sol[0], sol[1], float(np.sqrt(r2))) if r2 > 0 else None
-
-
 def _guess_cylinder(p, axis):
     o = p.mean(axis=0)
     x, y, _, e1, e2 = in_axis_frame(p, axis, o)
-    got = _kasa(x, y)
+    got = kasa(x, y)
     if got is None:
         return None
     cx, cy, r = got
@@ -236,7 +228,7 @@ def _guess_torus(p, axis, point):
     d = p - point
     z = d @ axis
     rho = np.linalg.norm(d - np.outer(z, axis), axis=1)
-    got = _kasa(rho, z)
+    got = kasa(rho, z)
     if got is None:
         return None
     R, z0, r = got

@@ -12,7 +12,8 @@ import numpy as np
 from curvenet.core.geometry import bbox_diagonal, fit_plane
 from curvenet.core.tolerances import DIVISION_GUARD
 
-__all__ = ["CURVE_TOL", "fit_circle", "straight", "in_axis_frame", "normal_to", "unit"]
+__all__ = ["CURVE_TOL", "fit_circle", "kasa", "straight", "in_axis_frame", "normal_to",
+           "unit"]
 
 #: A curve is straight (a ruling) when its points lie this close to its chord, and a
 #: circular arc when they lie this close to a circle (fractions of the curve's extent).
@@ -64,16 +65,22 @@ def fit_circle(points, *, tol: float = CURVE_TOL):
     if ext <= 0 or np.abs((p - c) @ n).max() > tol * ext:
         return None
     x, y, _, e1, e2 = in_axis_frame(p, n, c)
+    got = kasa(x, y)
+    if got is None:
+        return None
+    cx, cy, r = got
+    if np.abs(np.hypot(x - cx, y - cy) - r).max() > tol * ext or r > 1e3 * ext:
+        return None
+    return c + cx * e1 + cy * e2, n, r
+
+
+def kasa(x, y):
+    """Kasa's linear circle fit to points ``x, y`` ((n,) float64 each) in a plane:
+    ``(cx, cy, r)``, or None where the fit has no real radius."""
     A = np.c_[2 * x, 2 * y, np.ones_like(x)]
     sol, *_ = np.linalg.lstsq(A, x * x + y * y, rcond=None)
     r2 = sol[2] + sol[0] ** 2 + sol[1] ** 2
-    if not r2 > 0:
-        return None
-    r = float(np.sqrt(r2))
-    centre = c + sol[0] * e1 + sol[1] * e2
-    if np.abs(np.hypot(x - sol[0], y - sol[1]) - r).max() > tol * ext or r > 1e3 * ext:
-        return None
-    return centre, n, r
+    return (sol[0], sol[1], float(np.sqrt(r2))) if r2 > 0 else None
 
 
 def straight(points, tol: float = CURVE_TOL):

@@ -165,6 +165,7 @@ def test_a_torus_that_crosses_itself_is_refused():
     assert got is not None and got.radius == pytest.approx(3.0, rel=1e-9)
     assert fit_analytic(_torus_patch(0.3), tol=1e-9, diagonal=3.0, kinds=("torus",)) is None
 
+
 def _tilted_ring(phi, R, r, height, tilt, towards, psi):
     """Tube angles ``psi (n,)`` where the plane ``z = height + tan(tilt) x . (cos towards,
     sin towards)`` cuts the meridians at ``phi (n,)`` (Newton from ``psi``)."""
