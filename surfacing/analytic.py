@@ -40,9 +40,9 @@ import numpy as np
 from curvenet.core.geometry import bbox_diagonal, fit_plane
 from curvenet.core.tolerances import DIVISION_GUARD
 
-from .arcs import fit_circle, in_axis_frame, kasa, normal_to, straight, unit
+from .arcs import circle_spread, fit_circle, in_axis_frame, kasa, normal_to, straight, unit
 
-__all__ = ["AnalyticSurface", "fit_analytic", "fit_circle", "KINDS", "ANALYTIC_TOL",
+__all__ = ["AnalyticSurface", "fit_analytic", "fit_kind", "fit_circle", "KINDS", "ANALYTIC_TOL",
            "MAX_RADIUS", "FREEDOMS", "in_axis_frame"]
 
 #: Surface kinds, simplest first: the order :func:`fit_analytic` tries them in.
@@ -421,20 +421,71 @@ def fit_analytic(curves, *, tol: float, diagonal: float, kinds=KINDS, loops=None
         if axes is None:
             shapes = _shapes(curves)
             axes, arcs = _axis_guesses(p, shapes)
-        near = [] if kind != "torus" else [
-            a for a in (fit_circle(cv, tol=GUESS_CURVE_TOL) for cv in curves) if a is not None]
-        best = None
-        for x, res in _refined(kind, p, _candidates(kind, p, axes, arcs, near), tol):
-            if best is None or res < best[1]:
-                best = (x, res)
+        best = _best(kind, p, curves, axes, arcs, tol, GUESS_CURVE_TOL)
         if best is not None and best[1] <= tol:
             s = _rebased(_surface(kind, best[0], best[1]), p)
-            if (max(abs(s.radius), s.minor if kind == "torus" else 0.0) <= MAX_RADIUS * diagonal
-                    and not _through_singularity(s, p, tol, loops)
+            if (not _too_wide(s, diagonal) and not _through_singularity(s, p, tol, loops)
                     and (kind != "cone" or _drawn_cone(s, curves, shapes, tol))
                     and _arcs_on(s, curves, shapes, tol)):
                 return s
     return None
+
+
+def _best(kind, p, curves, axes, arcs, tol: float, guess_tol: float, guess_curves=None):
+    """``(x, max |residual|)`` of the best refined guess of one kind, or None
+    (``guess_tol``: curves this close to a circle give torus axes, the
+    ``guess_curves`` closest of them when given)."""
+    near = []
+    if kind == "torus":
+        got = [(a, cv) for a, cv in ((fit_circle(cv, tol=guess_tol), cv) for cv in curves)
+               if a is not None]
+        if guess_curves is not None and len(got) > guess_curves:
+            got.sort(key=lambda ac: circle_spread(*ac))
+            got = got[:guess_curves]
+        near = [a for a, _ in got]
+    best = None
+    for x, res in _refined(kind, p, _candidates(kind, p, axes, arcs, near), tol):
+        if best is None or res < best[1]:
+            best = (x, res)
+    return best
+
+
+def fit_kind(curves, kind: str, *, diagonal: float, guess_tol: float, guess_curves: int):
+    """The surface of one kind closest to noisy samples, whatever its distance.
+
+    Parameters
+    ----------
+    curves : list of (m_i, 3) float64
+    kind : str
+        One of :data:`KINDS` but ``"plane"``.
+    diagonal : float
+        Radii above :data:`MAX_RADIUS` times it are refused.
+    guess_tol, guess_curves : float, int
+        The ``guess_curves`` curves closest to a circle among those within ``guess_tol``
+        of their extent of one give the torus's axis guesses (:func:`_meridian_axes`).
+
+    Returns
+    -------
+    AnalyticSurface or None
+        Its ``residual`` the largest distance of a sample; None when no guess refines to a
+        surface without a singular point among the samples (:func:`_through_singularity`)
+        and within the radius bound.
+    """
+    curves = [np.asarray(c, np.float64) for c in curves]
+    p = np.concatenate(curves)
+    if _distinct(p, 0.0) <= FREEDOMS[kind]:
+        return None
+    axes, arcs = _axis_guesses(p, _shapes(curves))
+    best = _best(kind, p, curves, axes, arcs, 0.0, guess_tol, guess_curves)
+    if best is None:
+        return None
+    s = _rebased(_surface(kind, best[0], best[1]), p)
+    return None if _too_wide(s, diagonal) or _through_singularity(s, p, best[1]) else s
+
+
+def _too_wide(s: AnalyticSurface, diagonal: float) -> bool:
+    """Whether a radius of ``s`` passes :data:`MAX_RADIUS` diagonals."""
+    return max(abs(s.radius), s.minor if s.kind == "torus" else 0.0) > MAX_RADIUS * diagonal
 
 
 def _arcs_on(s: AnalyticSurface, curves, shapes, tol: float) -> bool:

@@ -12,8 +12,8 @@ import numpy as np
 from curvenet.core.geometry import bbox_diagonal, fit_plane
 from curvenet.core.tolerances import DIVISION_GUARD
 
-__all__ = ["CURVE_TOL", "fit_circle", "kasa", "straight", "in_axis_frame", "normal_to",
-           "unit"]
+__all__ = ["CURVE_TOL", "circle_spread", "fit_circle", "kasa", "straight", "in_axis_frame",
+           "normal_to", "unit"]
 
 #: A curve is straight (a ruling) when its points lie this close to its chord, and a
 #: circular arc when they lie this close to a circle (fractions of the curve's extent).
@@ -81,6 +81,16 @@ def kasa(x, y):
     sol, *_ = np.linalg.lstsq(A, x * x + y * y, rcond=None)
     r2 = sol[2] + sol[0] ** 2 + sol[1] ** 2
     return (sol[0], sol[1], float(np.sqrt(r2))) if r2 > 0 else None
+
+
+def circle_spread(arc, points) -> float:
+    """Largest distance of ``points`` (n, 3) to the circle ``arc`` ``(centre, normal,
+    radius)`` (:func:`fit_circle`), as a fraction of its radius."""
+    centre, normal, r = arc
+    d = np.asarray(points, np.float64) - centre
+    h = d @ normal
+    rho = np.linalg.norm(d - np.outer(h, normal), axis=1)
+    return float(np.hypot(rho - r, h).max() / r)
 
 
 def straight(points, tol: float = CURVE_TOL):
