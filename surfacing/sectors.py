@@ -22,6 +22,7 @@ import numpy as np
 from curvenet.core.geometry import bbox_diagonal, fit_plane
 
 from .analytic import ANALYTIC_TOL, AnalyticSurface, fit_analytic
+from .regions import onto_shared, shared_surfaces
 from .api import DEFAULT_EDGE_LENGTH, DEFAULT_MAX_FACES, PatchMeshResult, surface_loops
 from .bands import mesh_bands
 from .flat import FLAT_TOL, flat_planes, flatten_planar, loop_points, mesh_flat
@@ -394,14 +395,18 @@ def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: f
         V, F, face_patch, res.curve_vertices, curves, boundaries, flat, normals,
         offsets, edge_length=target if auto else None,
         max_faces=max(DEFAULT_MAX_FACES, len(F)) if auto else None)
+    shared: list = []
     if analytic_tol is not None:
         V = _on_surfaces(V, F, face_patch, surfaces, _heights(curves, boundaries, surfaces))
+        on, shared = shared_surfaces(curves, boundaries, curved=~flat, exact=surfaces)
+        V = onto_shared(V, F, face_patch, on)
     report = dict(res.report, n_patches=len(boundaries), n_sectors=len(loops),
                   cuts=len(all_curves) - n, flat_patches=int(flat.sum()),
                   flat_meshed=int(meshed.sum()), bands=np.flatnonzero(banded).tolist(),
                   n_faces=len(F), unsplit_holes=unsplit,
                   loop_patch=owner.tolist(),
-                  analytic=[None if s is None else s.to_dict() for s in surfaces])
+                  analytic=[None if s is None else s.to_dict() for s in surfaces],
+                  shared=shared)
     new_curves = None if res.curves is None else res.curves[:n]
     return PatchMeshResult(V, F, report, face_patch=face_patch, curves=new_curves,
                            control_vertices=res.control_vertices,
