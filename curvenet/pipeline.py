@@ -127,7 +127,8 @@ def export_cad(path, result: SurfaceResult, *, schema: str = "AP214",
     """Write the classical surface of ``result`` as a B-rep (STEP or 3DM).
 
     Patches the surfacer found to lie on a plane, cylinder, cone, sphere or torus
-    (``diagnostics["classical"]["analytic"]``) become that surface trimmed by their
+    (``diagnostics["classical"]["analytic"]``, and the patches of a region that shares
+    one within the drawing's noise, ``["shared"]``) become that surface trimmed by their
     curves, the others the B-spline pieces of the fitted control mesh
     (:func:`surfacing.bspline.extract_bsplines`); see :func:`curvenet.cad.write_cad`.
 
@@ -162,6 +163,9 @@ def export_cad(path, result: SurfaceResult, *, schema: str = "AP214",
     ps = result.patchset
     surfaces = [None if a is None else AnalyticSurface.from_dict(a)
                 for a in rep.get("analytic", [None] * len(ps.patches))]
+    for region in rep.get("shared", []):        # trimmed by the strokes, off it by the noise
+        for k in region["patches"]:
+            surfaces[k] = AnalyticSurface.from_dict(region["surface"])
     holed_flat = [k for k, p in enumerate(ps.patches) if p.holes and surfaces[k] is None
                   and rep.get("flat_meshed", 0)]
     if holed_flat:
