@@ -87,6 +87,11 @@ def _regions(boundaries, curved) -> list:
     return [r for r in (ids[lab[ids] == v] for v in np.unique(lab[ids])) if len(r)]
 
 
+def _samples(curves, boundary) -> np.ndarray:
+    """The samples (n, 3) of a patch's curves, each curve once."""
+    return np.concatenate([curves[c] for c in sorted({c for lp in boundary for c, _ in lp})])
+
+
 def _rms(s, p) -> float:
     """Root mean square distance of ``p`` (n, 3) to ``s``, or to their own plane
     (``s`` None)."""
@@ -154,9 +159,6 @@ def shared_surfaces(curves, boundaries, *, curved, exact=None):
     diag = bbox_diagonal(curves) or 1.0
     out: list = [None] * len(boundaries)
     found = []
-    def boundary_points(k):
-        return np.concatenate([curves[c] for c in {c for lp in boundaries[k] for c, _ in lp}])
-
     for region in _regions(boundaries, np.asarray(curved, bool)):
         if len(region) < SHARED_PATCHES:
             continue
@@ -176,7 +178,8 @@ def shared_surfaces(curves, boundaries, *, curved, exact=None):
         else:
             continue
         keep = [int(k) for k in region if (exact is None or exact[k] is None)
-                and _rms(s, boundary_points(k)) < _rms(None, boundary_points(k))
+                and _rms(s, _samples(curves, boundaries[k])) < _rms(
+                    None, _samples(curves, boundaries[k]))
                 and not _winds(s, [loop_points(curves, lp) for lp in boundaries[k]])]
         if not keep:
             continue
