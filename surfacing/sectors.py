@@ -22,10 +22,10 @@ import numpy as np
 from curvenet.core.geometry import bbox_diagonal, fit_plane
 
 from .analytic import ANALYTIC_TOL, AnalyticSurface, fit_analytic
-from .regions import onto_shared, shared_surfaces
 from .api import DEFAULT_EDGE_LENGTH, DEFAULT_MAX_FACES, PatchMeshResult, surface_loops
 from .bands import mesh_bands
 from .flat import FLAT_TOL, flat_planes, flatten_planar, loop_points, mesh_flat
+from .regions import onto_shared, shared_surfaces
 
 __all__ = ["split_holed", "split_boundaries", "surface_boundaries", "analytic_faces",
            "UnsplittableFace"]
@@ -355,8 +355,10 @@ def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: f
         Patches whose boundary lies on a plane, cylinder, cone, sphere or torus within
         this fraction of the diagonal (:func:`analytic_faces`) get their mesh vertices
         projected onto it, those of revolution bounded by parallels and a seam meshed as
-        rings about their axis (:func:`surfacing.bands.mesh_bands`); None: no analytic
-        faces (every face as the fit leaves it).
+        rings about their axis (:func:`surfacing.bands.mesh_bands`); the other curved
+        patches of a region whose curves share one within the drawing's noise are put
+        on it (:func:`surfacing.regions.shared_surfaces`); None: neither (every face as
+        the fit leaves it).
     **options
         Passed to :func:`surfacing.surface_loops` (``crease_curves``, ``resolution``, ...).
 
@@ -369,8 +371,9 @@ def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: f
         ``loop_patch`` (the patch of each loop of the control net, sectors included)
         and ``analytic``: per patch the
         :meth:`~surfacing.analytic.AnalyticSurface.to_dict` of its surface (with
-        ``residual`` in model units) or None; ``curves`` (when asked for) holds the
-        input curves only.
+        ``residual`` in model units) or None; ``shared``: per region put on one
+        surface its kind, patches and residuals (:func:`surfacing.regions.
+        shared_surfaces`); ``curves`` (when asked for) holds the input curves only.
     """
     n = len(curves)
     flat, normals, offsets = flat_planes(curves, boundaries, flat_tol)
