@@ -40,7 +40,8 @@ import numpy as np
 from curvenet.core.geometry import bbox_diagonal, fit_plane
 from curvenet.core.tolerances import DIVISION_GUARD
 
-from .arcs import circle_spread, fit_circle, in_axis_frame, kasa, normal_to, straight, unit
+from .arcs import (circle_spread, fit_circle, in_axis_frame, kasa, normal_to, straight,
+                   turns, unit)
 
 __all__ = ["AnalyticSurface", "fit_analytic", "fit_kind", "fit_circle", "KINDS", "ANALYTIC_TOL",
            "MAX_RADIUS", "FREEDOMS", "in_axis_frame"]
@@ -590,10 +591,8 @@ def _through_singularity(s: AnalyticSurface, p, tol: float, loops=None) -> bool:
         return False
     e1 = s.xdir
     e2 = np.cross(s.axis, e1)
-    turns = 0.0
+    total = 0.0
     for lp in loops:
         d = np.asarray(lp, np.float64) - apex
-        a = np.arctan2(d @ e2, d @ e1)
-        step = np.diff(np.r_[a, a[:1]])
-        turns += float(np.sum((step + np.pi) % (2 * np.pi) - np.pi)) / (2 * np.pi)
-    return round(turns) != 0
+        total += turns(np.arctan2(d @ e2, d @ e1))
+    return round(total) != 0

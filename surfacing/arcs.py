@@ -13,7 +13,7 @@ from curvenet.core.geometry import bbox_diagonal, fit_plane
 from curvenet.core.tolerances import DIVISION_GUARD
 
 __all__ = ["CURVE_TOL", "circle_spread", "fit_circle", "kasa", "straight", "in_axis_frame",
-           "normal_to", "unit"]
+           "normal_to", "turns", "unit"]
 
 #: A curve is straight (a ruling) when its points lie this close to its chord, and a
 #: circular arc when they lie this close to a circle (fractions of the curve's extent).
@@ -40,6 +40,13 @@ def in_axis_frame(points, axis, origin):
     e2 = np.cross(axis, e1)
     d = np.asarray(points) - origin
     return d @ e1, d @ e2, d @ axis, e1, e2
+
+
+def turns(angles) -> float:
+    """Turns (float) of the closed sequence ``angles`` (n,) in radians, each step taken
+    the short way round: the winding number of a loop about a point."""
+    step = np.diff(np.r_[angles, angles[:1]])
+    return float(np.sum((step + np.pi) % (2 * np.pi) - np.pi)) / (2 * np.pi)
 
 
 def fit_circle(points, *, tol: float = CURVE_TOL):
