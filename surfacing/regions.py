@@ -41,11 +41,11 @@ import numpy as np
 from curvenet.core.geometry import bbox_diagonal, fit_plane
 
 from .analytic import ANALYTIC_TOL, fit_kind
-from .arcs import fit_circle, straight
+from .arcs import fit_circle, straight, turns
 from .flat import loop_points
 
-__all__ = ["shared_surfaces", "onto_shared", "explain_shared", "SHARED_RMS", "SHARED_MAX",
-           "SHARED_PATCHES", "SHARED_KINDS"]
+__all__ = ["shared_surfaces", "onto_shared", "explain_shared", "vertex_patch", "SHARED_RMS",
+           "SHARED_MAX", "SHARED_PATCHES", "SHARED_KINDS"]
 
 #: Root mean square distance of a region's curve samples to its surface, fraction of the
 #: diagonal: about the drawing's own noise (a smooth wobble of 0.3% of the diagonal at
@@ -101,12 +101,6 @@ def _rms(s, p) -> float:
     return float(np.sqrt(np.mean(s.distance(p) ** 2)))
 
 
-def _turns(a) -> int:
-    """Whole turns of the closed sequence of angles ``a`` (n,)."""
-    step = np.diff(np.r_[a, a[:1]])
-    return int(round(float(np.sum((step + np.pi) % (2 * np.pi) - np.pi)) / (2 * np.pi)))
-
-
 def _winds(s, loops) -> bool:
     """Whether a patch's loops (each (n_i, 3) in walking order) together wind around
     the axis of ``s`` (a cylinder, cone or torus) or around a torus's tube: such loops
@@ -114,14 +108,14 @@ def _winds(s, loops) -> bool:
     round a torus's tube), so the patch is not on it."""
     if s.kind not in ("cylinder", "cone", "torus"):
         return False
-    around = tube = 0
+    around = tube = 0.0
     for lp in loops:
         d = np.asarray(lp, np.float64) - s.origin
         x, y, z = d @ s.xdir, d @ s.ydir, d @ s.axis
-        around += _turns(np.arctan2(y, x))
+        around += turns(np.arctan2(y, x))
         if s.kind == "torus":
-            tube += _turns(np.arctan2(z, np.hypot(x, y) - s.radius))
-    return around != 0 or tube != 0
+            tube += turns(np.arctan2(z, np.hypot(x, y) - s.radius))
+    return round(around) != 0 or round(tube) != 0
 
 
 def _drawn_exactly(c) -> bool:
@@ -209,6 +203,18 @@ def explain_shared(report) -> str | None:
         f"{r['max']:.2%} max off it)" for r in regions)
 
 
+def vertex_patch(F, face_patch, n: int) -> np.ndarray:
+    """Per vertex of a mesh with ``n`` vertices and faces ``F`` (m, 3) of patches
+    ``face_patch`` (m,), the patch whose faces alone use it: (n,) int64, -1 where faces
+    of two patches or none do."""
+    pairs = np.unique(np.c_[np.asarray(F).ravel(), np.repeat(face_patch, 3)], axis=0)
+    count = np.bincount(pairs[:, 0], minlength=n)
+    owner = np.full(n, -1, np.int64)
+    owner[pairs[:, 0]] = pairs[:, 1]
+    owner[count > 1] = -1
+    return owner
+
+
 def _normals(s, points, step: float) -> np.ndarray:
     """Unit normals (n, 3) of ``s`` at ``points`` on it: the gradient of its signed
     distance, by central differences of ``step``."""
@@ -235,16 +241,10 @@ def onto_shared(V, F, face_patch, surfaces) -> np.ndarray:
     if all(s is None for s in surfaces):
         return V
     F = np.asarray(F, np.int64)
-    face_patch = np.asarray(face_patch, np.int64)
     e = np.sort(np.r_[F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]], axis=1)
     edges, uses = np.unique(e, axis=0, return_counts=True)
-    open_v = np.zeros(len(V), bool)
-    open_v[edges[uses == 1].ravel()] = True
-    pairs = np.unique(np.c_[F.ravel(), np.repeat(face_patch, 3)], axis=0)
-    count = np.bincount(pairs[:, 0], minlength=len(V))
-    owner = np.full(len(V), -1, np.int64)
-    owner[pairs[:, 0]] = pairs[:, 1]
-    owner[(count > 1) | open_v] = -1
+    owner = vertex_patch(F, face_patch, len(V))
+    owner[edges[uses == 1].ravel()] = -1
     by_surface: dict = {}
     for k, s in enumerate(surfaces):
         if s is not None:

@@ -25,7 +25,7 @@ from .analytic import ANALYTIC_TOL, AnalyticSurface, fit_analytic
 from .api import DEFAULT_EDGE_LENGTH, DEFAULT_MAX_FACES, PatchMeshResult, surface_loops
 from .bands import mesh_bands
 from .flat import FLAT_TOL, flat_planes, flatten_planar, loop_points, mesh_flat
-from .regions import onto_shared, shared_surfaces
+from .regions import onto_shared, shared_surfaces, vertex_patch
 
 __all__ = ["split_holed", "split_boundaries", "surface_boundaries", "analytic_faces",
            "UnsplittableFace"]
@@ -295,11 +295,7 @@ def _on_surfaces(V, F, face_patch, surfaces, heights=None):
     continuation beyond them).
     """
     V = np.array(V, dtype=np.float64)
-    pairs = np.unique(np.c_[np.asarray(F).ravel(), np.repeat(face_patch, 3)], axis=0)
-    count = np.bincount(pairs[:, 0], minlength=len(V))
-    owner = np.full(len(V), -1, np.int64)
-    owner[pairs[:, 0]] = pairs[:, 1]
-    owner[count > 1] = -1
+    owner = vertex_patch(F, face_patch, len(V))
     for p, s in enumerate(surfaces):
         if s is not None:
             ids = np.flatnonzero(owner == p)
