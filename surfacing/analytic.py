@@ -43,7 +43,7 @@ from curvenet.core.tolerances import DIVISION_GUARD
 from .arcs import (circle_spread, fit_circle, in_axis_frame, kasa, normal_to, straight,
                    turns, unit)
 
-__all__ = ["AnalyticSurface", "fit_analytic", "fit_kind", "fit_circle", "KINDS", "ANALYTIC_TOL",
+__all__ = ["AnalyticSurface", "fit_analytic", "fit_kinds", "fit_circle", "KINDS", "ANALYTIC_TOL",
            "MAX_RADIUS", "FREEDOMS", "in_axis_frame"]
 
 #: Surface kinds, simplest first: the order :func:`fit_analytic` tries them in.
@@ -451,37 +451,39 @@ def _best(kind, p, curves, axes, arcs, tol: float, guess_tol: float, guess_curve
     return best
 
 
-def fit_kind(curves, kind: str, *, diagonal: float, guess_tol: float, guess_curves: int):
-    """The surface of one kind closest to noisy samples, whatever its distance.
+def fit_kinds(curves, kinds, *, diagonal: float, guess_tol: float, guess_curves: int):
+    """Per kind, the surface closest to noisy samples, whatever its distance.
 
     Parameters
     ----------
     curves : list of (m_i, 3) float64
-    kind : str
-        One of :data:`KINDS` but ``"plane"``.
+    kinds : sequence of str
+        Of :data:`KINDS` but ``"plane"``; fitted lazily, in this order.
     diagonal : float
         Radii above :data:`MAX_RADIUS` times it are refused.
     guess_tol, guess_curves : float, int
         The ``guess_curves`` curves closest to a circle among those within ``guess_tol``
         of their extent of one give the torus's axis guesses (:func:`_meridian_axes`).
 
-    Returns
-    -------
+    Yields
+    ------
     AnalyticSurface or None
-        Its ``residual`` the largest distance of a sample; None when no guess refines to a
-        surface without a singular point among the samples (:func:`_through_singularity`)
-        and within the radius bound.
+        Per kind, its ``residual`` the largest distance of a sample; None when the samples
+        do not over-determine it (:data:`FREEDOMS`) or no guess refines to one within the
+        radius bound and without a singular point (:func:`_through_singularity`).
     """
     curves = [np.asarray(c, np.float64) for c in curves]
     p = np.concatenate(curves)
-    if _distinct(p, 0.0) <= FREEDOMS[kind]:
-        return None
+    distinct = _distinct(p, 0.0)
     axes, arcs = _axis_guesses(p, _shapes(curves))
-    best = _best(kind, p, curves, axes, arcs, 0.0, guess_tol, guess_curves)
-    if best is None:
-        return None
-    s = _rebased(_surface(kind, best[0], best[1]), p)
-    return None if _too_wide(s, diagonal) or _through_singularity(s, p, best[1]) else s
+    for kind in kinds:
+        best = None if distinct <= FREEDOMS[kind] else _best(
+            kind, p, curves, axes, arcs, 0.0, guess_tol, guess_curves)
+        if best is None:
+            yield None
+            continue
+        s = _rebased(_surface(kind, best[0], best[1]), p)
+        yield None if _too_wide(s, diagonal) or _through_singularity(s, p, best[1]) else s
 
 
 def _too_wide(s: AnalyticSurface, diagonal: float) -> bool:

@@ -40,7 +40,7 @@ import numpy as np
 
 from curvenet.core.geometry import bbox_diagonal, fit_plane
 
-from .analytic import ANALYTIC_TOL, fit_kind
+from .analytic import ANALYTIC_TOL, fit_kinds
 from .arcs import fit_circle, straight, turns
 from .flat import loop_points
 
@@ -93,12 +93,15 @@ def _samples(curves, boundary) -> np.ndarray:
 
 
 def _rms(s, p) -> float:
-    """Root mean square distance of ``p`` (n, 3) to ``s``, or to their own plane
-    (``s`` None)."""
-    if s is None:
-        c, n, _ = fit_plane(p)
-        return float(np.sqrt(np.mean(((p - c) @ n) ** 2)))
+    """Root mean square distance of ``p`` (n, 3) to the surface ``s``."""
     return float(np.sqrt(np.mean(s.distance(p) ** 2)))
+
+
+def _closer_than_a_plane(s, p) -> bool:
+    """Whether samples ``p`` (n, 3) lie closer to ``s`` than to their own plane, by
+    root mean square."""
+    c, n, _ = fit_plane(p)
+    return _rms(s, p) < float(np.sqrt(np.mean(((p - c) @ n) ** 2)))
 
 
 def _winds(s, loops) -> bool:
@@ -159,21 +162,20 @@ def shared_surfaces(curves, boundaries, *, curved, exact=None):
         pts = [curves[c] for c in sorted({c for k in region for lp in boundaries[k]
                                           for c, _ in lp})]
         p = np.concatenate(pts)
-        for kind in SHARED_KINDS:
-            s = fit_kind(pts, kind, diagonal=diag, guess_tol=GUESS_TOL,
-                         guess_curves=GUESS_CURVES)
+        drawn = [c for c in pts if _drawn_exactly(c)]
+        for s in fit_kinds(pts, SHARED_KINDS, diagonal=diag, guess_tol=GUESS_TOL,
+                           guess_curves=GUESS_CURVES):
             if s is None:
                 continue
             rms = _rms(s, p)
             if (rms <= SHARED_RMS * diag and s.residual <= SHARED_MAX * diag
                     and all(np.abs(s.distance(c)).max() <= ANALYTIC_TOL * diag
-                            for c in pts if _drawn_exactly(c))):
+                            for c in drawn)):
                 break
         else:
             continue
         keep = [int(k) for k in region if (exact is None or exact[k] is None)
-                and _rms(s, _samples(curves, boundaries[k])) < _rms(
-                    None, _samples(curves, boundaries[k]))
+                and _closer_than_a_plane(s, _samples(curves, boundaries[k]))
                 and not _winds(s, [loop_points(curves, lp) for lp in boundaries[k]])]
         if not keep:
             continue
