@@ -32,7 +32,9 @@ section drawn as one stroke through its crossings, with a smooth wobble of 0.3% 
 diagonal, its start anywhere and its end 0-1% past or short of it: strokes that cross
 without shared points), ``rough`` (:func:`curvenet.datasets.redraw.rough_sketch`, one
 stroke per curve with gaps, overshoots and overdraw) and ``points`` (unordered samples
-of the curves, every 0.4% of the diagonal, read by point-curve recovery).
+of the curves, every 0.4% of the diagonal, read by point-curve recovery); on request
+``jitter``: the ``rough`` strokes with every sample moved by an independent Gaussian of
+:data:`JITTER` times the diagonal (per-sample noise, which the smooth wobble is not).
 
 Run ``python benchmarks/bench_genus.py [--only torus sphere ...] [--inputs clean rough]
 [--pictures DIR] [--classical JSON]``; prints one row per case and the worst F per family.
@@ -222,6 +224,10 @@ def through_sketch(net, *, seed: int, wobble: float = 0.003, slack: float = 0.01
     return Sketch(strokes, ["boundary"] * len(strokes))
 
 
+#: Per-sample noise of the ``jitter`` input, fraction of the diagonal (standard deviation).
+JITTER = 0.002
+
+
 def inputs(shape, kind, seed=0):
     net = shape.network
     if kind == "clean":
@@ -230,6 +236,8 @@ def inputs(shape, kind, seed=0):
         return through_sketch(net, seed=seed), "auto"
     if kind == "rough":
         return rough_sketch(net, seed=seed), "auto"
+    if kind == "jitter":
+        return rough_sketch(net, seed=seed, jitter=JITTER), "auto"
     pts = shapes.sample_curves([e.curve for e in net.edges], 0.004 * net.diagonal, rng=seed)
     return Sketch([pts], ["boundary"]), True
 
@@ -257,7 +265,8 @@ def run(shape, kind, pictures=None, classical=None):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--only", nargs="*", help="families (torus, sphere, capsule, ...)")
-    ap.add_argument("--inputs", nargs="*", default=["clean", "through", "rough", "points"])
+    ap.add_argument("--inputs", nargs="*", default=["clean", "through", "rough", "points"],
+                    choices=["clean", "through", "rough", "points", "jitter"])
     ap.add_argument("--pictures", type=Path, help="folder for one preview per case")
     ap.add_argument("--classical", type=json.loads, metavar="JSON",
                     help='classical_options of curvenet.surface, e.g. \'{"fit": "lsq"}\'')

@@ -49,7 +49,7 @@ def _stroke(rng, curve, s0, s1, diag, wobble, spacing):
 
 def rough_sketch(network: CurveNetwork, *, seed: int, wobble: float = 0.003,
                  overshoot: float = 0.015, gap: float = 0.01, overdraw: float = 0.15,
-                 split: float = 0.25, samples: int = 40) -> Sketch:
+                 split: float = 0.25, samples: int = 40, jitter: float = 0.0) -> Sketch:
     """Re-draw a clean network as rough strokes.
 
     Parameters
@@ -73,6 +73,11 @@ def rough_sketch(network: CurveNetwork, *, seed: int, wobble: float = 0.003,
         Probability that a curve's stroke is split in two with a ``gap``.
     samples : int
         Points per curve-length stroke (about; shorter pieces get fewer, min 8).
+    jitter : float
+        Standard deviation of an independent Gaussian offset of every sample (each
+        coordinate), fraction of the diagonal: a tracker's or a hand's per-sample
+        noise, on top of the smooth wobble. Drawn after everything else, so a seed gives
+        the same strokes with and without it.
 
     Returns
     -------
@@ -93,7 +98,7 @@ def rough_sketch(network: CurveNetwork, *, seed: int, wobble: float = 0.003,
     True
     """
     for name, v in (("wobble", wobble), ("overshoot", overshoot), ("gap", gap),
-                    ("overdraw", overdraw), ("split", split)):
+                    ("overdraw", overdraw), ("split", split), ("jitter", jitter)):
         if not (np.isfinite(v) and v >= 0):
             raise InvalidParameterError(f"{name} must be a finite number >= 0, got {v!r}")
     if overdraw > 1 or split > 1:
@@ -128,9 +133,12 @@ def rough_sketch(network: CurveNetwork, *, seed: int, wobble: float = 0.003,
     order = rng.permutation(len(strokes))
     flip = rng.random(len(strokes)) < 0.5
     out = [strokes[i][::-1].copy() if flip[i] else strokes[i] for i in order]
+    if jitter > 0:                                  # drawn last: the strokes stay the same
+        out = [st + rng.normal(scale=jitter * diag, size=st.shape) for st in out]
     return Sketch(out, [labels[i] for i in order],
                   {"redraw": {"seed": int(seed), "wobble": wobble, "overshoot": overshoot,
-                              "gap": gap, "overdraw": overdraw, "split": split}})
+                              "gap": gap, "overdraw": overdraw, "split": split,
+                              "jitter": jitter}})
 
 
 def match_networks(reference: CurveNetwork, result: CurveNetwork, *, tol: float = 0.02,

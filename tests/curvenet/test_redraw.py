@@ -56,6 +56,25 @@ def test_amplitudes_are_bounded():
             assert np.linalg.norm(corners - end, axis=1).min() <= 0.015 * diag + 1e-12
 
 
+def test_jitter_moves_every_sample_by_its_deviation_and_leaves_default_sketches_alone():
+    net = shapes.box().network
+    diag = net.diagonal
+    plain = dict(wobble=0, overshoot=0, gap=0, overdraw=0, split=0)
+    base = rough_sketch(net, seed=3, **plain)
+    noisy = rough_sketch(net, seed=3, jitter=0.002, **plain)
+    off = np.concatenate([b - n for b, n in zip(base.strokes, noisy.strokes)])
+    # same strokes, each sample moved by an independent Gaussian of 0.2% of the diagonal
+    assert off.shape[0] == len(base.points)
+    assert abs(off.std() / diag - 0.002) < 0.0003
+    assert abs(np.corrcoef(off[1:, 0], off[:-1, 0])[0, 1]) < 0.2
+    assert noisy.metadata["redraw"]["jitter"] == 0.002
+    # jitter 0 draws nothing: the default sketches of a seed stay as they were
+    for x, y in zip(rough_sketch(net, seed=5).strokes, rough_sketch(net, seed=5, jitter=0).strokes):
+        np.testing.assert_array_equal(x, y)
+    with pytest.raises(InvalidParameterError, match="jitter"):
+        rough_sketch(net, seed=0, jitter=-1)
+
+
 def test_split_gap_and_overdraw_counts():
     net = shapes.saddle_grid().network
     sk = rough_sketch(net, seed=2, split=1.0, overdraw=0.0)
