@@ -22,7 +22,7 @@ import numpy as np
 from curvenet.core.geometry import bbox_diagonal, fit_plane
 
 __all__ = ["FLAT_TOL", "flat_planes", "flatten_planar", "mesh_flat", "loop_points",
-           "replace_faces"]
+           "curve_ids", "replace_faces"]
 
 #: A patch is flat when its boundary points lie this close to a plane (fraction of the diagonal).
 FLAT_TOL = 1e-6
@@ -35,6 +35,12 @@ def loop_points(curves, loop):
     the ids around the loop, (m,).
     """
     return np.concatenate([(curves[c] if f else curves[c][::-1])[:-1] for c, f in loop])
+
+
+def curve_ids(boundary) -> list:
+    """The curves of a patch's loops ``[[(curve index, forward), ...], ...]``, each once,
+    in increasing order."""
+    return sorted({c for lp in boundary for c, _ in lp})
 
 
 def flat_planes(curves, boundaries, tol: float = FLAT_TOL):

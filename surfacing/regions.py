@@ -38,11 +38,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from curvenet.core.geometry import bbox_diagonal, fit_plane
+from curvenet.core.geometry import bbox_diagonal, face_edges, fit_plane
 
 from .analytic import ANALYTIC_TOL, fit_kinds
 from .arcs import fit_circle, straight, turns
-from .flat import loop_points
+from .flat import curve_ids, loop_points
 
 __all__ = ["shared_surfaces", "onto_shared", "explain_shared", "vertex_patch", "SHARED_RMS",
            "SHARED_MAX", "SHARED_PATCHES", "SHARED_KINDS"]
@@ -75,7 +75,7 @@ def _regions(boundaries, curved) -> list:
     ids = np.flatnonzero(curved)
     rows, cols = [], []
     for k in ids:
-        cs = {c for lp in boundaries[k] for c, _ in lp}
+        cs = curve_ids(boundaries[k])
         rows += [k] * len(cs)
         cols += list(cs)
     if not rows:
@@ -89,7 +89,7 @@ def _regions(boundaries, curved) -> list:
 
 def _samples(curves, boundary) -> np.ndarray:
     """The samples (n, 3) of a patch's curves, each curve once."""
-    return np.concatenate([curves[c] for c in sorted({c for lp in boundary for c, _ in lp})])
+    return np.concatenate([curves[c] for c in curve_ids(boundary)])
 
 
 def _rms(s, p) -> float:
@@ -159,8 +159,7 @@ def shared_surfaces(curves, boundaries, *, curved, exact=None):
     for region in _regions(boundaries, np.asarray(curved, bool)):
         if len(region) < SHARED_PATCHES:
             continue
-        pts = [curves[c] for c in sorted({c for k in region for lp in boundaries[k]
-                                          for c, _ in lp})]
+        pts = [curves[c] for c in curve_ids([lp for k in region for lp in boundaries[k]])]
         p = np.concatenate(pts)
         drawn = [c for c in pts if _drawn_exactly(c)]
         for s in fit_kinds(pts, SHARED_KINDS, diagonal=diag, guess_tol=GUESS_TOL,
@@ -242,9 +241,7 @@ def onto_shared(V, F, face_patch, surfaces) -> np.ndarray:
     V = np.array(V, dtype=np.float64)
     if all(s is None for s in surfaces):
         return V
-    F = np.asarray(F, np.int64)
-    e = np.sort(np.r_[F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]], axis=1)
-    edges, uses = np.unique(e, axis=0, return_counts=True)
+    edges, uses = np.unique(face_edges(F), axis=0, return_counts=True)
     owner = vertex_patch(F, face_patch, len(V))
     owner[edges[uses == 1].ravel()] = -1
     by_surface: dict = {}

@@ -24,7 +24,7 @@ from curvenet.core.geometry import bbox_diagonal, fit_plane
 from .analytic import ANALYTIC_TOL, AnalyticSurface, fit_analytic
 from .api import DEFAULT_EDGE_LENGTH, DEFAULT_MAX_FACES, PatchMeshResult, surface_loops
 from .bands import mesh_bands
-from .flat import FLAT_TOL, flat_planes, flatten_planar, loop_points, mesh_flat
+from .flat import FLAT_TOL, curve_ids, flat_planes, flatten_planar, loop_points, mesh_flat
 from .regions import onto_shared, shared_surfaces, vertex_patch
 
 __all__ = ["split_holed", "split_boundaries", "surface_boundaries", "analytic_faces",
@@ -267,8 +267,7 @@ def analytic_faces(curves, boundaries, *, tol: float = ANALYTIC_TOL, flat=None, 
     diag = bbox_diagonal(curves) or 1.0
     out = []
     for k, b in enumerate(boundaries):
-        ids = sorted({c for lp in b for c, _ in lp})
-        pts = [curves[c] for c in ids]
+        pts = [curves[c] for c in curve_ids(b)]
         if flat is not None and flat[k]:
             p = np.concatenate(pts)
             n = np.asarray(normals[k], np.float64)
