@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from curvenet.core.geometry import bbox_diagonal, face_edges, fit_plane
+from curvenet.core.geometry import bbox_diagonal, fit_plane, harmonic_fill, mesh_edges
 
 from .analytic import ANALYTIC_TOL, fit_kinds
 from .arcs import fit_circle, straight, turns
@@ -208,10 +208,13 @@ def vertex_patch(F, face_patch, n: int) -> np.ndarray:
     """Per vertex of a mesh with ``n`` vertices and faces ``F`` (m, 3) of patches
     ``face_patch`` (m,), the patch whose faces alone use it: (n,) int64, -1 where faces
     of two patches or none do."""
-    pairs = np.unique(np.c_[np.asarray(F).ravel(), np.repeat(face_patch, 3)], axis=0)
-    count = np.bincount(pairs[:, 0], minlength=n)
+    patch = np.repeat(np.asarray(face_patch, np.int64), 3)
+    base = int(patch.max(initial=0)) + 1
+    keys = np.unique(np.asarray(F, np.int64).ravel() * base + patch)   # (vertex, patch) pairs
+    vertex, patch = np.divmod(keys, base)
+    count = np.bincount(vertex, minlength=n)
     owner = np.full(n, -1, np.int64)
-    owner[pairs[:, 0]] = pairs[:, 1]
+    owner[vertex] = patch
     owner[count > 1] = -1
     return owner
 
@@ -236,12 +239,10 @@ def onto_shared(V, F, face_patch, surfaces) -> np.ndarray:
     mesh meets the strokes, and lies on a parallel of the elementary surface that
     follows their offsets smoothly.
     """
-    from scipy.sparse import coo_matrix, diags
-    from scipy.sparse.linalg import spsolve
     V = np.array(V, dtype=np.float64)
     if all(s is None for s in surfaces):
         return V
-    edges, uses = np.unique(face_edges(F), axis=0, return_counts=True)
+    edges, uses = mesh_edges(F)
     owner = vertex_patch(F, face_patch, len(V))
     owner[edges[uses == 1].ravel()] = -1
     by_surface: dict = {}
@@ -254,14 +255,7 @@ def onto_shared(V, F, face_patch, surfaces) -> np.ndarray:
         ids = np.flatnonzero(inner)
         if not len(ids):
             continue
-        touch = edges[inner[edges[:, 0]] | inner[edges[:, 1]]]
-        a, b = touch[:, 0], touch[:, 1]
-        A = coo_matrix((np.ones(2 * len(touch)), (np.r_[a, b], np.r_[b, a])),
-                       shape=(len(V), len(V))).tocsr()
-        A_i = A[ids]
-        height = np.where(inner, 0.0, s.distance(V))
-        L = diags(np.asarray(A_i.sum(axis=1)).ravel()) - A_i[:, ids]
-        h = spsolve(L.tocsc(), A_i @ height)
+        h = harmonic_fill(edges, inner, np.where(inner, 0.0, s.distance(V)))[ids]
         P = s.project(V[ids])
-        V[ids] = P + np.asarray(h)[:, None] * _normals(s, P, step)
+        V[ids] = P + h[:, None] * _normals(s, P, step)
     return V

@@ -34,6 +34,8 @@ __all__ = [
     "densify_polyline",
     "face_normals_areas",
     "face_edges",
+    "mesh_edges",
+    "harmonic_fill",
     "boundary_edges",
     "subdivide_curved",
     "sample_surface",
@@ -381,8 +383,24 @@ def boundary_edges(faces: np.ndarray) -> np.ndarray:
     >>> boundary_edges(np.array([[0, 1, 2], [2, 1, 3]])).tolist()
     [[0, 1], [0, 2], [1, 3], [2, 3]]
     """
-    edges, count = np.unique(face_edges(faces), axis=0, return_counts=True)
+    edges, count = mesh_edges(faces)
     return edges[count == 1]
+
+
+def mesh_edges(faces) -> tuple[np.ndarray, np.ndarray]:
+    """Each edge of a triangle mesh once, the smaller id first, rows in lexicographic
+    order: (e, 2) int64; and the number of triangles using each: (e,) int64.
+
+    Examples
+    --------
+    >>> edges, uses = mesh_edges(np.array([[0, 1, 2], [2, 1, 3]]))
+    >>> edges.tolist(), uses.tolist()
+    ([[0, 1], [0, 2], [1, 2], [1, 3], [2, 3]], [1, 1, 2, 1, 1])
+    """
+    e = face_edges(faces)
+    base = int(e.max(initial=0)) + 1        # one integer key per edge: a 1-D sort
+    keys, uses = np.unique(e[:, 0] * base + e[:, 1], return_counts=True)
+    return np.stack(np.divmod(keys, base), axis=1), uses
 
 
 def face_edges(faces) -> np.ndarray:
@@ -396,6 +414,50 @@ def face_edges(faces) -> np.ndarray:
     """
     f = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
     return np.sort(f[:, [0, 1, 1, 2, 2, 0]].reshape(-1, 2), axis=1)
+
+
+def harmonic_fill(edges, inner, values) -> np.ndarray:
+    """Values at the ``inner`` vertices of a graph made harmonic (each the mean of its
+    neighbours', the uniform graph Laplacian's Dirichlet problem) given the others.
+
+    Parameters
+    ----------
+    edges : (e, 2) int64
+        Undirected edges, each once.
+    inner : (n,) bool
+        Vertices whose values are solved for; every connected set of them must touch
+        another vertex.
+    values : (n,) or (n, k) float64
+        Known values at the vertices not ``inner`` (those at ``inner`` are ignored).
+
+    Returns
+    -------
+    (n,) or (n, k) float64
+        A copy of ``values`` with the ``inner`` entries replaced.
+
+    Examples
+    --------
+    >>> harmonic_fill(np.array([[0, 1], [1, 2], [2, 3]]), np.array([0, 1, 1, 0], bool),
+    ...               np.array([0.0, 9.0, 9.0, 3.0])).tolist()
+    [0.0, 1.0, 2.0, 3.0]
+    """
+    from scipy.sparse import coo_matrix, diags
+    from scipy.sparse.linalg import spsolve
+    inner = np.asarray(inner, dtype=bool)
+    out = np.array(values, dtype=np.float64)
+    ids = np.flatnonzero(inner)
+    if not len(ids):
+        return out
+    edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
+    touch = edges[inner[edges[:, 0]] | inner[edges[:, 1]]]
+    a, b = touch[:, 0], touch[:, 1]
+    n = len(inner)
+    A = coo_matrix((np.ones(2 * len(touch)), (np.r_[a, b], np.r_[b, a])), shape=(n, n)).tocsr()
+    A_i = A[ids]
+    known = np.where(inner.reshape((-1,) + (1,) * (out.ndim - 1)), 0.0, out)
+    L = diags(np.asarray(A_i.sum(axis=1)).ravel()) - A_i[:, ids]
+    out[ids] = np.asarray(spsolve(L.tocsc(), A_i @ known)).reshape(out[ids].shape)
+    return out
 
 
 def subdivide_curved(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
