@@ -305,8 +305,7 @@ def _surface_one(inp: str, out: str, args) -> dict:
     """Surface one input; returns a status row (never raises CurvenetError)."""
     from .io.network import read_patches
     from .pipeline import surface
-    from .surfacing.api import explain_fit
-    from .surfacing.regions import explain_shared
+    from .surfacing.sectors import explain_boundaries
     t0 = time.perf_counter()
     try:
         ps = read_patches(args.patches) if args.patches else None
@@ -331,8 +330,7 @@ def _surface_one(inp: str, out: str, args) -> dict:
                 "snap": res.diagnostics.get("snap", {}).get("summary", ""),
                 "regions": res.decision.explain_regions(),
                 "check": res.decision.explain_check(),
-                "fit": explain_fit(res.diagnostics.get("classical")),
-                "shared": explain_shared(res.diagnostics.get("classical")),
+                "classical": explain_boundaries(res.diagnostics.get("classical")),
                 "fidelity": res.diagnostics.get("fidelity"),
                 "cad": res.diagnostics.get("cad")}
     except CurvenetError as err:
@@ -395,7 +393,7 @@ def _cmd_surface(args) -> int:
         reading = row.get("reading") and f"reading: {row['reading']}"
         for line in [reading, row["snap"], f"route: {row['why']}",
                      *(f"  region {r}" for r in row.get("regions", [])),
-                     row.get("check"), row.get("fit"), row.get("shared")]:
+                     row.get("check"), *row.get("classical", [])]:
             if line:
                 print(line)
         if row.get("fidelity"):

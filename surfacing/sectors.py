@@ -22,13 +22,15 @@ import numpy as np
 from curvenet.core.geometry import bbox_diagonal, fit_plane
 
 from .analytic import ANALYTIC_TOL, AnalyticSurface, fit_analytic
-from .api import DEFAULT_EDGE_LENGTH, DEFAULT_MAX_FACES, PatchMeshResult, surface_loops
+from .api import (DEFAULT_EDGE_LENGTH, DEFAULT_MAX_FACES, DEFAULT_TOL, PatchMeshResult,
+                  explain_fit, surface_loops)
+from .denoise import explain_denoised, restore, smooth_curves
 from .bands import mesh_bands
 from .flat import FLAT_TOL, curve_ids, flat_planes, flatten_planar, loop_points, mesh_flat
-from .regions import onto_shared, shared_surfaces, vertex_patch
+from .regions import explain_shared, onto_shared, shared_surfaces, vertex_patch
 
 __all__ = ["split_holed", "split_boundaries", "surface_boundaries", "analytic_faces",
-           "UnsplittableFace"]
+           "explain_boundaries", "UnsplittableFace"]
 
 
 def _start(curves, item):
@@ -331,7 +333,8 @@ def _heights(curves, boundaries, surfaces) -> list:
 
 
 def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: float = FLAT_TOL,
-                       analytic_tol: float | None = ANALYTIC_TOL, **options):
+                       analytic_tol: float | None = ANALYTIC_TOL, denoise: bool = True,
+                       **options):
     """:func:`surfacing.surface_loops` for patches that may have holes; flat patches flat,
     analytic patches on their surface.
 
@@ -354,6 +357,9 @@ def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: f
         patches of a region whose curves share one within the drawing's noise are put
         on it (:func:`surfacing.regions.shared_surfaces`); None: neither (every face as
         the fit leaves it).
+    denoise : bool
+        Surface the curves with per-sample noise smoothed, then put the noise back on
+        the mesh (:mod:`surfacing.denoise`, at the fit's ``tol``).
     **options
         Passed to :func:`surfacing.surface_loops` (``crease_curves``, ``resolution``, ...).
 
@@ -368,12 +374,18 @@ def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: f
         :meth:`~surfacing.analytic.AnalyticSurface.to_dict` of its surface (with
         ``residual`` in model units) or None; ``shared``: per region put on one
         surface its kind, patches and residuals (:func:`surfacing.regions.
-        shared_surfaces`); ``curves`` (when asked for) holds the input curves only.
+        shared_surfaces`); ``denoised``: the curves smoothed (:func:`surfacing.denoise.
+        smooth_curves`); ``curves`` (when asked for) holds the input curves only.
     """
     n = len(curves)
+    curves = [np.asarray(c, dtype=np.float64) for c in curves]
+    # the fit and the shared surfaces take the smoothed curves, the tests for flat and exact
+    # faces the drawn ones (a smoothed curve is off its smoothing by more than they allow)
+    smooth, denoised = (smooth_curves(curves, options.get("tol", DEFAULT_TOL)) if denoise
+                        else (curves, []))
     flat, normals, offsets = flat_planes(curves, boundaries, flat_tol)
     outer_only = [b[:1] if f else b for b, f in zip(boundaries, flat)]
-    all_curves, loops, owner, unsplit = split_boundaries(curves, outer_only, cut_samples)
+    all_curves, loops, owner, unsplit = split_boundaries(smooth, outer_only, cut_samples)
     res = surface_loops(all_curves, loops, **options)
     face_patch = owner[res.face_patch]
     V = flatten_planar(res.vertices, res.faces, face_patch, flat, normals, offsets)
@@ -396,16 +408,33 @@ def surface_boundaries(curves, boundaries, *, cut_samples: int = 17, flat_tol: f
     shared: list = []
     if analytic_tol is not None:
         V = _on_surfaces(V, F, face_patch, surfaces, _heights(curves, boundaries, surfaces))
-        on, shared = shared_surfaces(curves, boundaries, curved=~flat, exact=surfaces)
+        on, shared = shared_surfaces(smooth, boundaries, curved=~flat, exact=surfaces)
         V = onto_shared(V, F, face_patch, on)
+    if denoised:
+        V = restore(V, F, face_patch, smooth, curves)
     report = dict(res.report, n_patches=len(boundaries), n_sectors=len(loops),
                   cuts=len(all_curves) - n, flat_patches=int(flat.sum()),
                   flat_meshed=int(meshed.sum()), bands=np.flatnonzero(banded).tolist(),
                   n_faces=len(F), unsplit_holes=unsplit,
                   loop_patch=owner.tolist(),
                   analytic=[None if s is None else s.to_dict() for s in surfaces],
-                  shared=shared)
+                  shared=shared, denoised=denoised)
     new_curves = None if res.curves is None else res.curves[:n]
     return PatchMeshResult(V, F, report, face_patch=face_patch, curves=new_curves,
                            control_vertices=res.control_vertices,
                            control_quads=res.control_quads, control_net=res.control_net)
+
+
+def explain_boundaries(report) -> list:
+    """The lines ``--explain`` prints about a :func:`surface_boundaries` report: the fit
+    (:func:`surfacing.api.explain_fit`), the shared surfaces (:func:`surfacing.regions.
+    explain_shared`) and the smoothed curves (:func:`surfacing.denoise.explain_denoised`),
+    each where it has something to say; [] for another surfacer's report (or None).
+
+    Examples
+    --------
+    >>> explain_boundaries({"fit": "lsq", "shared": [], "denoised": []})
+    ['fit: lsq']
+    """
+    lines = (explain(report) for explain in (explain_fit, explain_shared, explain_denoised))
+    return [line for line in lines if line]

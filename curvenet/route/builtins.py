@@ -21,7 +21,7 @@ __all__: list = []
 #: surface_loops arguments the pipeline fills from the network and the settings
 _FROM_PIPELINE = ("crease_curves", "crease_angle")
 #: surface_boundaries' own options beside those of surface_loops
-_BOUNDARY_OPTIONS = ("analytic_tol",)
+_BOUNDARY_OPTIONS = ("analytic_tol", "denoise")
 
 
 def _loops_kwargs(options: dict, settings: SurfaceSettings) -> dict:

@@ -174,6 +174,13 @@ def test_snap_and_explain_print_the_snapping_line(tmp_path):
     # the fit auto kept, with the bending energy of each fit it tried
     fit = [x for x in r.stdout.splitlines() if x.startswith("fit: ")]
     assert len(fit) == 1 and "bending energy lsq " in fit[0] and "sweep " in fit[0]
+    assert not any(x.startswith("smoothed: ") for x in r.stdout.splitlines())
+    # the same box drawn with per-sample jitter: its curves smoothed for the fit
+    write_sketch(rough, rough_sketch(shapes.box().network, seed=0, jitter=0.002))
+    r = run("surface", rough, "-o", tmp_path / "j.obj", "--method", "classical", "--explain")
+    assert r.returncode == 0, r.stderr
+    assert any(x.startswith("smoothed: ") and "per-sample noise" in x
+               for x in r.stdout.splitlines()), r.stdout
 
 
 def test_edge_length_sets_the_output_density(tmp_path, box_obj):
