@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from curvenet.core.geometry import bbox_diagonal, cumulative_length, harmonic_fill, mesh_edges
+from curvenet.core.geometry import bbox_diagonal, cumulative_length, harmonic_fill
 from curvenet.core.tolerances import ZERO_LENGTH
 
 __all__ = ["smooth_curves", "restore", "chord_offsets", "explain_denoised", "MIN_SAMPLES",
@@ -167,10 +167,9 @@ def restore(V, F, face_patch, smoothed, curves) -> np.ndarray:
         samples; the vertices inside the patches by the residuals' harmonic interpolation.
     """
     from scipy.spatial import cKDTree
-    from .regions import vertex_patch
+    from .regions import interior_patch
     V = np.array(V, dtype=np.float64)
-    moved = [k for k, (s, c) in enumerate(zip(smoothed, curves)) if s is not c]
-    if not moved or not len(V):
+    if not len(V) or all(s is c for s, c in zip(smoothed, curves)):
         return V
     pts = np.concatenate([np.asarray(s, np.float64) for s in smoothed])
     res = np.concatenate([np.asarray(c, np.float64) - np.asarray(s, np.float64)
@@ -178,9 +177,7 @@ def restore(V, F, face_patch, smoothed, curves) -> np.ndarray:
     sizes = np.array([len(s) for s in smoothed])
     first = np.repeat(np.cumsum(sizes) - sizes, sizes)
     last = first + np.repeat(sizes, sizes) - 1
-    edges, uses = mesh_edges(F)
-    owner = vertex_patch(F, face_patch, len(V))
-    owner[edges[uses == 1].ravel()] = -1
+    edges, owner = interior_patch(F, face_patch, len(V))
     on = np.flatnonzero(owner == -1)
     _, j = cKDTree(pts).query(V[on])
     best_d = np.full(len(on), np.inf)

@@ -44,8 +44,8 @@ from .analytic import ANALYTIC_TOL, fit_kinds
 from .arcs import fit_circle, straight, turns
 from .flat import curve_ids, loop_points
 
-__all__ = ["shared_surfaces", "onto_shared", "explain_shared", "vertex_patch", "SHARED_RMS",
-           "SHARED_MAX", "SHARED_PATCHES", "SHARED_KINDS"]
+__all__ = ["shared_surfaces", "onto_shared", "explain_shared", "vertex_patch", "interior_patch",
+           "SHARED_RMS", "SHARED_MAX", "SHARED_PATCHES", "SHARED_KINDS"]
 
 #: Root mean square distance of a region's curve samples to its surface, fraction of the
 #: diagonal: about the drawing's own noise (a smooth wobble of 0.3% of the diagonal at
@@ -219,6 +219,16 @@ def vertex_patch(F, face_patch, n: int) -> np.ndarray:
     return owner
 
 
+def interior_patch(F, face_patch, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """The edges of a mesh of ``n`` vertices (:func:`curvenet.core.geometry.mesh_edges`),
+    and per vertex the patch whose interior holds it: :func:`vertex_patch`, -1 also on
+    the mesh's open borders ((n,) int64)."""
+    edges, uses = mesh_edges(F)
+    owner = vertex_patch(F, face_patch, n)
+    owner[edges[uses == 1].ravel()] = -1
+    return edges, owner
+
+
 def _normals(s, points, step: float) -> np.ndarray:
     """Unit normals (n, 3) of ``s`` at ``points`` on it: the gradient of its signed
     distance, by central differences of ``step``."""
@@ -242,9 +252,7 @@ def onto_shared(V, F, face_patch, surfaces) -> np.ndarray:
     V = np.array(V, dtype=np.float64)
     if all(s is None for s in surfaces):
         return V
-    edges, uses = mesh_edges(F)
-    owner = vertex_patch(F, face_patch, len(V))
-    owner[edges[uses == 1].ravel()] = -1
+    edges, owner = interior_patch(F, face_patch, len(V))
     by_surface: dict = {}
     for k, s in enumerate(surfaces):
         if s is not None:
