@@ -449,11 +449,9 @@ def harmonic_fill(edges, inner, values) -> np.ndarray:
     if not len(ids):
         return out
     edges = np.asarray(edges, dtype=np.int64).reshape(-1, 2)
-    touch = edges[inner[edges[:, 0]] | inner[edges[:, 1]]]
-    a, b = touch[:, 0], touch[:, 1]
-    n = len(inner)
-    A = coo_matrix((np.ones(2 * len(touch)), (np.r_[a, b], np.r_[b, a])), shape=(n, n)).tocsr()
-    A_i = A[ids]
+    a, b = edges[inner[edges[:, 0]] | inner[edges[:, 1]]].T      # edges that touch them
+    A_i = coo_matrix((np.ones(2 * len(a)), (np.r_[a, b], np.r_[b, a])),
+                     shape=(len(inner),) * 2).tocsr()[ids]
     known = np.where(inner.reshape((-1,) + (1,) * (out.ndim - 1)), 0.0, out)
     L = diags(np.asarray(A_i.sum(axis=1)).ravel()) - A_i[:, ids]
     out[ids] = np.asarray(spsolve(L.tocsc(), A_i @ known)).reshape(out[ids].shape)
