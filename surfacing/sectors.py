@@ -24,8 +24,8 @@ from curvenet.core.geometry import bbox_diagonal, fit_plane
 from .analytic import ANALYTIC_TOL, AnalyticSurface, fit_analytic
 from .api import (DEFAULT_EDGE_LENGTH, DEFAULT_MAX_FACES, DEFAULT_TOL, PatchMeshResult,
                   explain_fit, surface_loops)
-from .denoise import explain_denoised, restore, smooth_curves
 from .bands import mesh_bands
+from .denoise import explain_denoised, restore, smooth_curves
 from .flat import FLAT_TOL, curve_ids, flat_planes, flatten_planar, loop_points, mesh_flat
 from .regions import explain_shared, onto_shared, shared_surfaces, vertex_patch
 
