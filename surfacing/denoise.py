@@ -31,6 +31,8 @@ import numpy as np
 from curvenet.core.geometry import bbox_diagonal, cumulative_length, harmonic_fill
 from curvenet.core.tolerances import ZERO_LENGTH
 
+from .polyline import closest_on_segments
+
 __all__ = ["smooth_curves", "restore", "chord_offsets", "explain_denoised", "MIN_SAMPLES",
            "MAX_AUTOCORRELATION", "END_WEIGHT"]
 
@@ -60,11 +62,7 @@ def chord_offsets(curve) -> np.ndarray:
     c = np.asarray(curve, dtype=np.float64)
     if len(c) < 3:
         return np.zeros(0)
-    a, p, b = c[:-2], c[1:-1], c[2:]
-    ab = b - a
-    den = np.einsum("ij,ij->i", ab, ab)
-    t = np.clip(np.einsum("ij,ij->i", p - a, ab) / np.maximum(den, ZERO_LENGTH ** 2), 0.0, 1.0)
-    return np.linalg.norm(p - a - t[:, None] * ab, axis=1)
+    return closest_on_segments(c[1:-1], c[:-2], c[2:])[1]
 
 
 #: Weight of a curve's two end samples in its smoothing (the others weigh 1): the ends
@@ -183,10 +181,8 @@ def restore(V, F, face_patch, smoothed, curves) -> np.ndarray:
     best_d = np.full(len(on), np.inf)
     shift = np.zeros((len(on), 3))
     for a, b in ((np.maximum(j - 1, first[j]), j), (j, np.minimum(j + 1, last[j]))):
-        ab = pts[b] - pts[a]
-        den = np.maximum(np.einsum("ij,ij->i", ab, ab), ZERO_LENGTH ** 2)
-        t = np.clip(np.einsum("ij,ij->i", V[on] - pts[a], ab) / den, 0.0, 1.0)[:, None]
-        d = np.linalg.norm(V[on] - pts[a] - t * ab, axis=1)
+        t, d = closest_on_segments(V[on], pts[a], pts[b])
+        t = t[:, None]
         closer = d < best_d
         best_d = np.where(closer, d, best_d)
         shift[closer] = ((1.0 - t) * res[a] + t * res[b])[closer]

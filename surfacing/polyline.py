@@ -1,4 +1,5 @@
-"""Polyline helpers of the classical surfacer: end tangents, point-to-polyline distance.
+"""Polyline helpers of the classical surfacer: end tangents, point-to-polyline distance,
+closest points of segments.
 
 Arc length, interpolation and resampling live in :mod:`curvenet.core.geometry`.
 
@@ -15,7 +16,7 @@ import numpy as np
 from curvenet.core.geometry import cumulative_length, interpolate_polyline, sample_at
 from curvenet.core.tolerances import DIVISION_GUARD
 
-__all__ = ["end_tangents", "point_polyline_distance"]
+__all__ = ["end_tangents", "point_polyline_distance", "closest_on_segments"]
 
 
 def end_tangents(curve: np.ndarray, fraction: float = 0.1,
@@ -62,10 +63,33 @@ def point_polyline_distance(points: np.ndarray, curve: np.ndarray) -> np.ndarray
     """
     points = np.asarray(points, dtype=np.float64)
     curve = np.asarray(curve, dtype=np.float64)
-    a, b = curve[:-1], curve[1:]                                  # (s, 3)
+    return closest_on_segments(points[:, None], curve[None, :-1], curve[None, 1:])[1].min(axis=1)
+
+
+def closest_on_segments(points, a, b) -> tuple[np.ndarray, np.ndarray]:
+    """Closest points of the segments ``a -> b`` to ``points``.
+
+    Parameters
+    ----------
+    points, a, b : (..., 3) float64
+        Broadcast against each other.
+
+    Returns
+    -------
+    t : (...) float64
+        Parameter of the closest point along each segment, in [0, 1] (0 on a segment of
+        zero length).
+    distance : (...) float64
+
+    Examples
+    --------
+    >>> t, d = closest_on_segments(np.array([[1.0, 1, 0]]), np.zeros((1, 3)),
+    ...                            np.array([[2.0, 0, 0]]))
+    >>> t.tolist(), d.tolist()
+    ([0.5], [1.0])
+    """
     ab = b - a
-    den = np.maximum(np.einsum("ij,ij->i", ab, ab), DIVISION_GUARD)  # zero-length segments
-    ap = points[:, None, :] - a[None]                             # (k, s, 3)
-    t = np.clip(np.einsum("ksj,sj->ks", ap, ab) / den, 0.0, 1.0)
-    d = ap - t[..., None] * ab[None]
-    return np.sqrt(np.min(np.einsum("ksj,ksj->ks", d, d), axis=1))
+    ap = points - a
+    t = np.clip((ap * ab).sum(axis=-1) / np.maximum((ab * ab).sum(axis=-1), DIVISION_GUARD),
+                0.0, 1.0)
+    return t, np.linalg.norm(ap - t[..., None] * ab, axis=-1)
