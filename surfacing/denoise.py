@@ -209,11 +209,13 @@ def explain_denoised(report) -> str | None:
     >>> print(explain_denoised({"denoised": [{"curve": 3, "rms": 0.002, "max": 0.0061},
     ...                                      {"curve": 7, "rms": 0.0018, "max": 0.0052}]}))
     smoothed: 2 curves of per-sample noise (RMS 0.18%-0.20%, at most 0.61% of the diagonal)
+    >>> print(explain_denoised({"denoised": [{"curve": 0, "rms": 0.001, "max": 0.0021}]}))
+    smoothed: 1 curve of per-sample noise (RMS 0.10%, at most 0.21% of the diagonal)
     """
     rows = (report or {}).get("denoised")
     if not rows:
         return None
-    rms = [r["rms"] for r in rows]
+    lo, hi = (f"{f([r['rms'] for r in rows]):.2%}" for f in (min, max))
     return (f"smoothed: {len(rows)} curve{'s' * (len(rows) > 1)} of per-sample noise "
-            f"(RMS {min(rms):.2%}-{max(rms):.2%}, at most "
+            f"(RMS {lo if lo == hi else f'{lo}-{hi}'}, at most "
             f"{max(r['max'] for r in rows):.2%} of the diagonal)")
