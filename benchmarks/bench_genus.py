@@ -34,10 +34,11 @@ without shared points), ``rough`` (:func:`curvenet.datasets.redraw.rough_sketch`
 stroke per curve with gaps, overshoots and overdraw) and ``points`` (unordered samples
 of the curves, every 0.4% of the diagonal, read by point-curve recovery); on request
 ``jitter``: the ``rough`` strokes with every sample moved by an independent Gaussian of
-:data:`JITTER` times the diagonal (per-sample noise, which the smooth wobble is not).
+:data:`JITTER` (or ``--jitter``) times the diagonal (per-sample noise, which the smooth
+wobble is not).
 
 Run ``python benchmarks/bench_genus.py [--only torus sphere ...] [--inputs clean rough]
-[--pictures DIR] [--classical JSON]``; prints one row per case and the worst F per family.
+[--jitter FRAC] [--pictures DIR] [--classical JSON]``; prints one row per case and the worst F per family.
 """
 
 from __future__ import annotations
@@ -228,7 +229,7 @@ def through_sketch(net, *, seed: int, wobble: float = 0.003, slack: float = 0.01
 JITTER = 0.002
 
 
-def inputs(shape, kind, seed=0):
+def inputs(shape, kind, seed=0, jitter=JITTER):
     net = shape.network
     if kind == "clean":
         return shape.sketch(), "auto"
@@ -237,13 +238,13 @@ def inputs(shape, kind, seed=0):
     if kind == "rough":
         return rough_sketch(net, seed=seed), "auto"
     if kind == "jitter":
-        return rough_sketch(net, seed=seed, jitter=JITTER), "auto"
+        return rough_sketch(net, seed=seed, jitter=jitter), "auto"
     pts = shapes.sample_curves([e.curve for e in net.edges], 0.004 * net.diagonal, rng=seed)
     return Sketch([pts], ["boundary"]), True
 
 
-def run(shape, kind, pictures=None, classical=None):
-    sketch, points = inputs(shape, kind)
+def run(shape, kind, pictures=None, classical=None, jitter=JITTER):
+    sketch, points = inputs(shape, kind, jitter=jitter)
     t = time.perf_counter()
     res = curvenet.surface(sketch, points=points, classical_options=classical)
     sec = time.perf_counter() - t
@@ -270,6 +271,8 @@ def main(argv=None):
     ap.add_argument("--pictures", type=Path, help="folder for one preview per case")
     ap.add_argument("--classical", type=json.loads, metavar="JSON",
                     help='classical_options of curvenet.surface, e.g. \'{"fit": "lsq"}\'')
+    ap.add_argument("--jitter", type=float, default=JITTER,
+                    help="per-sample noise of the jitter input, fraction of the diagonal")
     args = ap.parse_args(argv)
     if args.pictures:
         args.pictures.mkdir(parents=True, exist_ok=True)
@@ -281,7 +284,7 @@ def main(argv=None):
             continue
         for kind in args.inputs:
             try:
-                r = run(shape, kind, args.pictures, args.classical)
+                r = run(shape, kind, args.pictures, args.classical, args.jitter)
             except curvenet.CurvenetError as err:
                 print(f"{shape.name:<34}{kind:<9}failed: {err}")
                 worst[(family, kind)] = 0.0

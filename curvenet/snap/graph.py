@@ -59,7 +59,9 @@ Pipeline of :func:`snap` (``mode="rough"``)
    more than :data:`curvenet.snap.merge.APART` tol apart there.
 5. Corners: where a stroke turns by more than ``corner_angle`` between the
    chords ``tol * corner_window`` before and after a point (local maximum),
-   and no junction is within ``2 tol``, it gets a degree-2 vertex. Where ``tol``
+   and no junction is within ``2 tol``, it gets a degree-2 vertex. Each chord end
+   is the stroke's mean over a quarter of the chord either side, so that per-sample
+   jitter (which tilts chords between single points) does not make corners. Where ``tol``
    is wider than :data:`DEFAULT_SNAP_TOL` (a tolerance measured from wide gaps, not
    from how tightly the strokes curve), the turn is the smaller of that and its mean
    with the turn over chords ``corner_window`` times the default tolerance: a circle
