@@ -38,7 +38,8 @@ of the curves, every 0.4% of the diagonal, read by point-curve recovery); on req
 wobble is not).
 
 Run ``python benchmarks/bench_genus.py [--only torus sphere ...] [--inputs clean rough]
-[--jitter FRAC] [--pictures DIR] [--classical JSON]``; prints one row per case and the worst F per family.
+[--jitter FRAC] [--pictures DIR] [--classical JSON]``; prints one row per case and the
+worst F per family.
 """
 
 from __future__ import annotations

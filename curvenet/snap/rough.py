@@ -414,12 +414,13 @@ def _corners(samples, w, w0, h, opts):
     The turn at ``s`` is the angle between the chords ``p(s - w) -> p(s)`` and
     ``p(s) -> p(s + w)``, ``w = corner_window * tol``, evaluated every ``h / 2``
     on all strokes at once; ``p(x)`` is the stroke's mean over ``x +- w / 4``
-    (:func:`_chord_end`), so that per-sample jitter does not make corners. Where ``w0 < w`` (a tolerance wider than the default,
-    :func:`corner_chords`), it is the smaller of that and its mean with the turn over
-    the chords ``w0``: a smooth curve turns in proportion to the chord, a corner
-    does not, so a circle as tight as the wide window (a torus's small circle at a
-    tolerance measured from wide gaps) is not cut into corners, while a corner
-    rounded over more than ``w0`` still turns enough over ``w``.
+    (:func:`_chord_end`), so that per-sample jitter does not make corners. Where
+    ``w0 < w`` (a tolerance wider than the default, :func:`corner_chords`), it is the
+    smaller of that and its mean with the turn over the chords ``w0``: a smooth curve
+    turns in proportion to the chord, a corner does not, so a circle as tight as the
+    wide window (a torus's small circle at a tolerance measured from wide gaps) is not
+    cut into corners, while a corner rounded over more than ``w0`` still turns enough
+    over ``w``.
     """
     flat = samples[5]
     ok = np.flatnonzero(flat.L > 2 * w)
