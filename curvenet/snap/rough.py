@@ -26,11 +26,9 @@ __all__ = ["snap_rough"]
 _MAX_SAMPLES = 2_000_000
 #: Samples of changed strokes whose neighbours are sought at once (bounds the pairs held).
 _PAIR_BLOCK = 100_000
-#: Each end of a turn chord is the mean of the stroke over +-``_CHORD_END_MEAN`` times the
-#: chord of arc (``_CHORD_END_POINTS`` points): per-sample jitter then tilts the chords
-#: far less, while a corner still turns by its angle less a few degrees.
+#: Each end of a turn chord is the stroke's mean over +-``_CHORD_END_MEAN`` chords of arc:
+#: per-sample jitter tilts the chords far less, a corner turns by its angle less a few degrees.
 _CHORD_END_MEAN = 0.25
-_CHORD_END_POINTS = 9
 
 
 def _contacts(samples, tol, h, st, opts, since=None):
@@ -414,7 +412,7 @@ def _corners(samples, w, w0, h, opts):
     The turn at ``s`` is the angle between the chords ``p(s - w) -> p(s)`` and
     ``p(s) -> p(s + w)``, ``w = corner_window * tol``, evaluated every ``h / 2``
     on all strokes at once; ``p(x)`` is the stroke's mean over ``x +- w / 4``
-    (:func:`_chord_end`), so that per-sample jitter does not make corners. Where
+    (:meth:`Flat.window_mean`), so that per-sample jitter does not make corners. Where
     ``w0 < w`` (a tolerance wider than the default, :func:`corner_chords`), it is the
     smaller of that and its mean with the turn over the chords ``w0``: a smooth curve
     turns in proportion to the chord, a corner does not, so a circle as tight as the
@@ -433,12 +431,12 @@ def _corners(samples, w, w0, h, opts):
     rel = np.arange(n.sum()) - np.repeat(np.cumsum(n) - n, n)
     s = w + rel * np.repeat((flat.L[ok] - 2 * w) / (n - 1), n)
     pos = rel + np.repeat(start[:-1], n)
-    p0, p1, p2 = (_chord_end(flat, kk, s + d, w) for d in (-w, 0.0, w))
+    p0, p1, p2 = (flat.window_mean(kk, s + d, _CHORD_END_MEAN * w) for d in (-w, 0.0, w))
     ang = np.full(start[-1], -1.0)
     ang[pos] = chord_turn(p0, p1, p2)
     if w0 < w:
-        t0 = chord_turn(_chord_end(flat, kk, s - w0, w0), _chord_end(flat, kk, s, w0),
-                        _chord_end(flat, kk, s + w0, w0))
+        t0 = chord_turn(*(flat.window_mean(kk, s + d, _CHORD_END_MEAN * w0)
+                          for d in (-w0, 0.0, w0)))
         ang[pos] = np.minimum(ang[pos], 0.5 * (ang[pos] + t0))
     peak = (ang >= maximum_filter1d(ang, 2 * pad - 1, mode="nearest")) & (ang > opts.corner_angle)
     out = {}
@@ -449,14 +447,6 @@ def _corners(samples, w, w0, h, opts):
         if not lst or s[q] - lst[-1] > w:
             lst.append(float(s[q]))
     return out
-
-
-def _chord_end(flat, kk, s, w):
-    """Chord ends ``(m, 3)``: the mean of strokes ``kk (m,)`` over the arc
-    ``s +- _CHORD_END_MEAN * w`` (clamped to the stroke)."""
-    t = np.linspace(-_CHORD_END_MEAN * w, _CHORD_END_MEAN * w, _CHORD_END_POINTS)
-    pts = flat.interp(np.repeat(kk, len(t)), (s[:, None] + t[None, :]).ravel())
-    return pts.reshape(len(s), len(t), 3).mean(axis=1)
 
 
 # --------------------------------------------------------------------------- assembly

@@ -137,6 +137,13 @@ class Flat:
         t = np.clip((g - self.G[j]) / np.maximum(seg, DIVISION_GUARD), 0.0, 1.0)  # guard 0-length
         return self.P[j] + t[:, None] * (self.P[j + 1] - self.P[j])
 
+    def window_mean(self, k, s, half, points=9):
+        """Means ``(m, 3)`` of strokes ``k (m,)`` over the arcs ``s +- half`` (``s (m,)``),
+        each from ``points`` evenly spaced points (clamped to the stroke)."""
+        t = np.linspace(-half, half, points)
+        p = self.interp(np.repeat(k, points), (np.asarray(s)[:, None] + t).ravel())
+        return p.reshape(-1, points, 3).mean(axis=1)
+
 
 def own_ends(samples, frac=LOOP_OVERLAP):
     """Where each stroke's ends come closest to its own other end's stretch.
