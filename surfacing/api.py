@@ -22,6 +22,7 @@ from .sharp import DEFAULT_CREASE_ANGLE, sharp_structure
 from .curveupdate import fit_cubic_curve
 from .fit import (FAIRNESS, LAMBDA, VSPRING_STEP, bending_energy, fairness_matrix,
                   fit_iterative, fit_lsq, swept_rows, variation_matrix)
+from .fitcheck import ESCAPE, escape, sweep_check
 from .limit import limit_matrix, tangent_matrices
 from .polyline import point_polyline_distance
 from .sides import DEFAULT_STRAIGHT_ANGLE
@@ -252,7 +253,7 @@ def surface_loops(curves, loops, *, crease_curves=(), crease_angle: float | None
         (:func:`surfacing.fit.bending_energy`; within :data:`AUTO_FIT_TIE` of the least,
         the first of :data:`AUTO_FIT_PREFERENCE`); where that is ``lsq`` but it departs
         from the swept shape by more than the shape's two sweeps depart from each other,
-        ``sweep`` (``_sweep_check``; the report's ``sweep_check``).
+        ``sweep`` (:func:`surfacing.fitcheck.sweep_check`; the report's ``sweep_check``).
     update_curves : bool or iterable of int
         Return curves refitted to the surface (Sec. 4.3.3): all when True, else the
         given indices (the others are returned unchanged).
@@ -344,7 +345,7 @@ def _fit_control_net(cm, sharp, *, fit, fairness, curve_weight, lam, tol, max_it
     (``{"fit": ..., "energy": {"lsq": e, "sweep": e or None, "iterative": e or None}}``;
     None: not tried: no swept loop, a control net too large for the iteration, or
     an iteration that did not reach ``tol`` within its steps), and where the energies
-    kept ``lsq`` and a swept fit exists, ``"sweep_check"`` (:func:`_sweep_check`).
+    kept ``lsq`` and a swept fit exists, ``"sweep_check"`` (:func:`.fitcheck.sweep_check`).
     """
     t0 = time.perf_counter()
     sharp_edges, corners = sharp
@@ -387,45 +388,36 @@ def _fit_control_net(cm, sharp, *, fit, fairness, curve_weight, lam, tol, max_it
             fits["iterative"] = Pi + fit_lsq(L, F, np.zeros_like(Pi), cons,
                                              targets - (L @ Pi)[cons])
             iters["iterative"] = it_i
+    left = {name: escape(Q, cm.quads, cm.face_patch, cm.on_curve, cm.target).max()
+            for name, Q in fits.items()}
+    if min(left.values()) > ESCAPE and "iterative" not in fits:
+        # every direct fit left a loop (surfacing.fitcheck): the iteration moves the Coons
+        # net locally, and is taken as it ends, without the exact correction
+        fits["iterative"], iters["iterative"] = _iterate(
+            cm, sharp, L, cons, targets, lam=lam, tol=tol * diag, steps=max_iter,
+            vspring_step=vspring_step)
+        left["iterative"] = escape(fits["iterative"], cm.quads, cm.face_patch, cm.on_curve,
+                                   cm.target).max()
     energy = {"lsq": None, "sweep": None, "iterative": None}
     if len(fits) > 1:
         level = _energy_level(cm)
         energy.update({name: bending_energy(*_limit_surface(Q, cm, sharp, level, {})[:2])
                        for name, Q in fits.items()})
-    best = next(iter(fits))
-    judged = [name for name in AUTO_FIT_PREFERENCE
-              if name in fits and energy[name] is not None and np.isfinite(energy[name])]
+    best = min(fits, key=left.get)
+    judged = [name for name in AUTO_FIT_PREFERENCE if name in fits and left[name] <= ESCAPE
+              and energy[name] is not None and np.isfinite(energy[name])]
     if judged:
         least = min(energy[name] for name in judged)
         best = next(name for name in judged if energy[name] <= least * (1.0 + AUTO_FIT_TIE))
     choice = {"fit": best, "energy": energy}
+    if max(left.values()) > ESCAPE:
+        choice["escaped"] = {name: float(e) for name, e in left.items()}
     if best == "lsq" and "sweep" in fits:
-        choice["sweep_check"] = _sweep_check(cm.spread, fits["lsq"], fits["sweep"], diag)
-        if choice["sweep_check"]["departure"] > choice["sweep_check"]["spread"]:
+        choice["sweep_check"] = sweep_check(cm.spread, fits["lsq"], fits["sweep"], diag)
+        if (choice["sweep_check"]["departure"] > choice["sweep_check"]["spread"]
+                and left["sweep"] <= ESCAPE):
             best = choice["fit"] = "sweep"
     return _fitted(fits[best], iters[best], L, cons, targets, choice, timings, t0)
-
-
-def _sweep_check(spread, P_lsq, P_sweep, diag: float) -> dict:
-    """Whether the drawn sections imply their swept shape more firmly than the fairness
-    energy does another: ``{"spread": s, "departure": d}``, fractions of ``diag``.
-
-    ``spread`` (n,) float64 is :attr:`ControlMesh.spread`, NaN outside the swept loops;
-    ``P_lsq``, ``P_sweep`` (n, 3) float64 the two fits. ``s``: its RMS over the control
-    vertices inside the swept loops, i.e. how much the swept shape is left open by its
-    sides (the sweep along ``u`` against the one along ``v``). ``d``: the RMS distance there
-    between the least-squares fit and the swept fit. Where the departure is the
-    larger, the least-squares fit moved the surface off a shape that the sections
-    predict, two ways, more alike than that move (a tall elliptic tube drawn as three
-    meridians: the two sweeps agree to the curves' sampling, the least-squares fit
-    rounds the tube between them); the sweep is kept although it bends more.
-    """
-    inside = np.isfinite(spread)
-    if not inside.any():
-        return {"spread": 0.0, "departure": 0.0}
-    dev = np.linalg.norm(P_lsq[inside] - P_sweep[inside], axis=1)
-    return {"spread": float(np.sqrt(np.mean(spread[inside] ** 2))) / diag,
-            "departure": float(np.sqrt(np.mean(dev ** 2))) / diag}
 
 
 def _iterate(cm, sharp, L, cons, targets, *, lam, tol, steps, vspring_step):
@@ -569,6 +561,9 @@ def explain_fit(report) -> str | None:
         line += (f"; lsq departs from the swept shape by {check['departure']:.2%} of the "
                  f"diagonal, {'more' if kept else 'no more'} than its two sweeps part "
                  f"({check['spread']:.2%}): {'sweep' if kept else 'lsq'} kept")
+    if report.get("escaped"):
+        left = ", ".join(f"{k} {e:.2f}" for k, e in report["escaped"].items() if e > ESCAPE)
+        line += f"; left a loop's box by more than {ESCAPE:g} times its size, not kept: {left}"
     return line + ")"
 
 

@@ -117,3 +117,33 @@ def test_auto_is_the_least_squares_fit_on_large_control_nets(monkeypatch):
     rep, _ = _fit(sections.great_circles(3), "auto")      # triangles only: nothing swept
     assert rep["fit"] == "lsq"
     assert rep["energy"] == {"lsq": None, "sweep": None, "iterative": None}
+
+
+def test_auto_keeps_no_fit_that_leaves_its_loops():
+    """Five great circles in general position drawn roughly with a 0.2% per-sample jitter
+    (the benchmark's ``circles`` #1, bench_genus.py): two close crossings leave small
+    patches with zig-zag sides folded onto each other, and the exact least-squares and
+    swept fits turn the fold into a petal about seven radii long, every stroke still
+    on it. ``auto`` sees both leave their loops' boxes and keeps the iteration."""
+    from curvenet.datasets.redraw import rough_sketch
+    from curvenet.model.network import CurveNetwork
+    from curvenet.surfacing.fitcheck import ESCAPE
+    rng = np.random.default_rng(44)
+    for _ in range(2):          # the benchmark's second sphere of five circles
+        while True:
+            nrm = rng.normal(size=(5, 3))
+            nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
+            if np.abs(nrm @ nrm.T)[np.triu_indices(5, 1)].max() <= np.cos(np.radians(20)):
+                break
+        move = shapes.random_motion(rng)
+    net = sections.great_circles(normals=nrm).network
+    moved = CurveNetwork(move(net.positions))
+    for e in net.edges:
+        moved.add_edge(e.u, e.v, move(e.curve), label=e.label)
+    res = curvenet.surface(rough_sketch(moved, seed=0, jitter=0.002), method="classical")
+    rep = res.diagnostics["classical"]
+    assert rep["fit"] == "iterative" and rep["escaped"]["iterative"] <= ESCAPE
+    assert min(rep["escaped"]["lsq"], rep["escaped"]["sweep"]) > ESCAPE
+    centre = move(np.zeros((1, 3)))[0]
+    radius = np.linalg.norm(move(np.array([[1.0, 0.0, 0.0]]))[0] - centre)
+    assert np.linalg.norm(res.mesh.vertices - centre, axis=1).max() < 1.2 * radius
