@@ -388,7 +388,7 @@ def _fit_control_net(cm, sharp, *, fit, fairness, curve_weight, lam, tol, max_it
             fits["iterative"] = Pi + fit_lsq(L, F, np.zeros_like(Pi), cons,
                                              targets - (L @ Pi)[cons])
             iters["iterative"] = it_i
-    left = {name: escape(Q, cm.quads, cm.face_patch, cm.on_curve, cm.target).max()
+    left = {name: escape(L @ Q, cm.quads, cm.face_patch, cm.on_curve, cm.target).max()
             for name, Q in fits.items()}
     if min(left.values()) > ESCAPE and "iterative" not in fits:
         # every direct fit left a loop (surfacing.fitcheck): the iteration moves the Coons
@@ -396,8 +396,8 @@ def _fit_control_net(cm, sharp, *, fit, fairness, curve_weight, lam, tol, max_it
         fits["iterative"], iters["iterative"] = _iterate(
             cm, sharp, L, cons, targets, lam=lam, tol=tol * diag, steps=max_iter,
             vspring_step=vspring_step)
-        left["iterative"] = escape(fits["iterative"], cm.quads, cm.face_patch, cm.on_curve,
-                                   cm.target).max()
+        left["iterative"] = escape(L @ fits["iterative"], cm.quads, cm.face_patch,
+                                   cm.on_curve, cm.target).max()
     energy = {"lsq": None, "sweep": None, "iterative": None}
     if len(fits) > 1:
         level = _energy_level(cm)
