@@ -390,6 +390,7 @@ def _fit_control_net(cm, sharp, *, fit, fairness, curve_weight, lam, tol, max_it
             iters["iterative"] = it_i
     left = {name: escape(L @ Q, cm.quads, cm.face_patch, cm.on_curve, cm.target).max()
             for name, Q in fits.items()}
+    direct = list(fits)
     if min(left.values()) > ESCAPE and "iterative" not in fits:
         # every direct fit left a loop (surfacing.fitcheck): the iteration moves the Coons
         # net locally, and is taken as it ends, without the exact correction
@@ -403,8 +404,9 @@ def _fit_control_net(cm, sharp, *, fit, fairness, curve_weight, lam, tol, max_it
         level = _energy_level(cm)
         energy.update({name: bending_energy(*_limit_surface(Q, cm, sharp, level, {})[:2])
                        for name, Q in fits.items()})
-    best = min(fits, key=left.get)
-    judged = [name for name in AUTO_FIT_PREFERENCE if name in fits and left[name] <= ESCAPE
+    ok = [name for name in fits if left[name] <= ESCAPE] or direct  # all left: as if unchecked
+    best = ok[0]
+    judged = [name for name in AUTO_FIT_PREFERENCE if name in ok
               and energy[name] is not None and np.isfinite(energy[name])]
     if judged:
         least = min(energy[name] for name in judged)
@@ -414,8 +416,7 @@ def _fit_control_net(cm, sharp, *, fit, fairness, curve_weight, lam, tol, max_it
         choice["escaped"] = {name: float(e) for name, e in left.items()}
     if best == "lsq" and "sweep" in fits:
         choice["sweep_check"] = sweep_check(cm.spread, fits["lsq"], fits["sweep"], diag)
-        if (choice["sweep_check"]["departure"] > choice["sweep_check"]["spread"]
-                and left["sweep"] <= ESCAPE):
+        if choice["sweep_check"]["departure"] > choice["sweep_check"]["spread"] and "sweep" in ok:
             best = choice["fit"] = "sweep"
     return _fitted(fits[best], iters[best], L, cons, targets, choice, timings, t0)
 
