@@ -345,7 +345,8 @@ def _fit_control_net(cm, sharp, *, fit, fairness, curve_weight, lam, tol, max_it
     (``{"fit": ..., "energy": {"lsq": e, "sweep": e or None, "iterative": e or None}}``;
     None: not tried: no swept loop, a control net too large for the iteration, or
     an iteration that did not reach ``tol`` within its steps), and where the energies
-    kept ``lsq`` and a swept fit exists, ``"sweep_check"`` (:func:`.fitcheck.sweep_check`).
+    kept ``lsq`` and a swept fit exists, ``"sweep_check"`` (:func:`.fitcheck.sweep_check`);
+    where a fit left a loop, ``"escaped"``: per fit its largest :func:`.fitcheck.escape`.
     """
     t0 = time.perf_counter()
     sharp_edges, corners = sharp
