@@ -15,10 +15,12 @@ from curvenet.surfacing.sectors import surface_boundaries
 
 @pytest.fixture(scope="module")
 def jittered_torus():
-    """A torus drawn with 4 meridians and 3 rings, re-drawn rough with a 0.2% jitter on
-    every sample: ``{denoise: result}`` and the true surface."""
-    shape = shapes.torus(1.0, 0.25, n_u=4, n_v=3)
-    sketch = rough_sketch(shape.network, seed=1, jitter=0.002)
+    """A torus drawn with 4 meridians and 3 rings, re-drawn rough with a 0.3% jitter on
+    every sample: ``{denoise: result}`` and the true surface. (At 0.2% the thinner torus
+    this was first measured on comes out round without the smoothing too, since the
+    snapping stopped cutting its strokes at false corners.)"""
+    shape = shapes.torus(1.0, 0.4, n_u=4, n_v=3)
+    sketch = rough_sketch(shape.network, seed=0, jitter=0.003)
     out = {flag: curvenet.surface(sketch, method="classical",
                                   classical_options={"denoise": flag})
            for flag in (True, False)}
