@@ -389,8 +389,11 @@ def _fit_control_net(cm, sharp, *, fit, fairness, curve_weight, lam, tol, max_it
             fits["iterative"] = Pi + fit_lsq(L, F, np.zeros_like(Pi), cons,
                                              targets - (L @ Pi)[cons])
             iters["iterative"] = it_i
-    left = {name: escape(L @ Q, cm.quads, cm.face_patch, cm.on_curve, cm.target).max()
-            for name, Q in fits.items()}
+
+    def left_of(Q):         # how far a fit leaves its loops (surfacing.fitcheck)
+        return escape(L @ Q, cm.quads, cm.face_patch, cm.on_curve, cm.target).max()
+
+    left = {name: left_of(Q) for name, Q in fits.items()}
     direct = list(fits)
     if min(left.values()) > ESCAPE and "iterative" not in fits:
         # every direct fit left a loop (surfacing.fitcheck): the iteration moves the Coons
@@ -398,8 +401,7 @@ def _fit_control_net(cm, sharp, *, fit, fairness, curve_weight, lam, tol, max_it
         fits["iterative"], iters["iterative"] = _iterate(
             cm, sharp, L, cons, targets, lam=lam, tol=tol * diag, steps=max_iter,
             vspring_step=vspring_step)
-        left["iterative"] = escape(L @ fits["iterative"], cm.quads, cm.face_patch,
-                                   cm.on_curve, cm.target).max()
+        left["iterative"] = left_of(fits["iterative"])
     energy = {"lsq": None, "sweep": None, "iterative": None}
     if len(fits) > 1:
         level = _energy_level(cm)
