@@ -21,6 +21,10 @@ heldout    ``--reference-quality`` on smooth closed sketches the presets were no
            second noise model of this file (:func:`_tremor_sketch`) on a sphere and an
            ellipsoid; each with ``polish=0`` (the last step) and as set: F-score, Chamfer,
            stroke fidelity
+wireframes ``--reference-quality`` and ``draft`` on clean sparse wireframes whose true surface
+           is known (the curves of the network, exact, no noise): tori of 4 meridians x 2
+           rings (tube radius 0.25 and 0.4) and 3 x 2 (0.4), and 3 great circles of a
+           sphere; F-score at 0.01 and Chamfer against the true surface
 vns        time and stroke fidelity per sketch (``--vns-quality``, default draft) on
            several vns sketches (``--vns all``: every ``*.obj`` under sketches/vns), PNG
            previews under ``--png-dir`` (default /tmp); fidelity is the share of stroke
@@ -69,6 +73,7 @@ def _worker(spec: dict) -> dict:
     torch.set_num_threads(spec.get("threads", 2))
     sys.path.insert(0, str(ROOT))
     from curvenet.neural.flow import fit_flow_surface
+    from curvenet.model.sketch import Sketch
     out = {}
     if spec["kind"] == "sketch":
         from curvenet.io.sketch import read_sketch
@@ -79,6 +84,9 @@ def _worker(spec: dict) -> dict:
         shape = latlong_sphere(n_lat=2, n_lon=6)
         sk = rough_sketch(shape.network, seed=spec.get("sketch_seed", 0), split=0.0,
                           overdraw=0.0)
+    elif spec["kind"] == "wireframe":
+        shape = _wireframe(spec["shape"])
+        sk = Sketch([e.curve for e in shape.network.edges])
     else:
         shape, sk = _heldout_sketch(spec["shape"], spec["noise"], spec["sketch_seed"])
     strokes, labels = sk.strokes, sk.labels
@@ -107,6 +115,19 @@ def _worker(spec: dict) -> dict:
         _render(r.vertices, r.faces, strokes, spec["png"])
         out["png"] = spec["png"]
     return out
+
+
+WIREFRAMES = ["torus r0.25 4x2", "torus r0.4 4x2", "torus r0.4 3x2", "sphere 3 circles"]
+
+
+def _wireframe(name: str):
+    """The :class:`AnalyticShape` of a ``WIREFRAMES`` name."""
+    from curvenet.datasets import sections, shapes
+    if name.startswith("sphere"):
+        return sections.great_circles(int(name.split()[1]))
+    _, r, counts = name.split()
+    meridians, rings = (int(k) for k in counts.split("x"))
+    return shapes.torus(1.0, float(r[1:]), n_u=meridians, n_v=rings)
 
 
 HELDOUT = [("ellipsoid", "rough", 0), ("torus", "rough", 0), ("sphere", "tremor", 1),
@@ -293,6 +314,17 @@ def main(argv=None):
                 _row("heldout", name, noise, seed, f"{label}: {r['polish']}",
                      f"{r['fscore']:.4f}", f"{r['chamfer']:.2e}",
                      f"{r.get('fidelity', 0.0):.3f}", f"{r['time_s']:.1f}s")
+    if "wireframes" in a.only:
+        _row("wireframes", "shape", "quality", "F-score@0.01", "Chamfer", "wall")
+        for name in WIREFRAMES:
+            for quality in ("draft", a.reference_quality):
+                r = _run({**base, "kind": "wireframe", "shape": name, "quality": quality,
+                          "overrides": overrides}, timeout=a.timeout)
+                if "error" in r:
+                    _row("wireframes", name, quality, r["error"])
+                    continue
+                _row("wireframes", name, quality, f"{r['fscore']:.4f}", f"{r['chamfer']:.2e}",
+                     f"{r['time_s']:.1f}s")
     if "vns" in a.only:
         names = a.vns
         if names == ["all"]:
