@@ -246,7 +246,7 @@ def main(argv=None):
     ap.add_argument("--timeout", type=float, default=3600,
                     help="seconds per rough sphere of the spheres section (loaded machines: more)")
     ap.add_argument("--set", nargs="*", default=[], metavar="NAME=VALUE",
-                    help="FlowConfig overrides of the spheres and vns sections")
+                    help="FlowConfig overrides (sections spheres, heldout, wireframes, vns)")
     ap.add_argument("--vns-quality", default="draft", help="preset of the vns section")
     ap.add_argument("--png-dir", default="/tmp", help="where the vns previews go")
     ap.add_argument("--worker", help=argparse.SUPPRESS)
