@@ -65,14 +65,13 @@ def escape(P, quads, face_patch, on_curve, target) -> np.ndarray:
     on = on_curve[v]
     np.minimum.at(lo, loop[on], target[v[on]])
     np.maximum.at(hi, loop[on], target[v[on]])
-    has = np.isfinite(lo[:, 0])
-    lo[~has], hi[~has] = 0.0, 0.0
-    out = np.linalg.norm(np.maximum(lo[loop] - P[v], 0.0) + np.maximum(P[v] - hi[loop], 0.0),
+    keep = np.isfinite(lo[:, 0])[loop]           # vertices of loops that have a box
+    lv, vv = loop[keep], v[keep]
+    out = np.linalg.norm(np.maximum(lo[lv] - P[vv], 0.0) + np.maximum(P[vv] - hi[lv], 0.0),
                          axis=1)
-    size = np.linalg.norm(hi - lo, axis=1)
+    size = np.linalg.norm(hi[lv] - lo[lv], axis=1)
     ratio = np.zeros(n_loops)
-    np.maximum.at(ratio, loop, out / np.maximum(size[loop], np.finfo(float).tiny))
-    ratio[~has] = 0.0
+    np.maximum.at(ratio, lv, out / np.maximum(size, np.finfo(float).tiny))
     return ratio
 
 
