@@ -33,6 +33,11 @@ Engineering choices (documented deviations / gap fills)
   sphere/MFGI init. The plain SIREN initialisation (paper text, ``paper``
   preset) starts from |g| ~ 0.05 and a rough, curl-heavy field, which a short
   CPU budget cannot recover from.
+* ``lowpass > 0`` (no preset) blurs every solved f by a Gaussian of that many cells,
+  in the spectral solve (:class:`neural.poisson.PoissonSolver`; the solver of Shape As
+  Points has the same filter, the published code about one cell): far from the
+  strokes the Monte-Carlo noise of a step's splat otherwise decides the sign of f
+  (:class:`neural.presets.FlowConfig` says when it helps).
 * The padded box is a cube (longest side + 20 % on every side) so the grid is
   isotropic.
 * Ctrl-C (KeyboardInterrupt) stops the optimisation

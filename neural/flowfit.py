@@ -122,7 +122,8 @@ class FlowFit:
         self.net = GradientSiren(cfg.width, cfg.hidden_layers, cfg.omega_0).to(
             device=dev, dtype=self.dtype)
         self.sampler = StrokeSampler(strokes_unit, dev, self.dtype)
-        self.solver = PoissonSolver(cfg.res, device=dev, dtype=self.dtype, boundary=cfg.boundary)
+        self.solver = PoissonSolver(cfg.res, device=dev, dtype=self.dtype, boundary=cfg.boundary,
+                                    lowpass=cfg.lowpass)
         self.f = None                  # the last solved f (unit-cube grid)
         self.lam = None                # d(data loss) / d(splat), for poisson_every > 1
         self.data = float("nan")       # the last solved data loss

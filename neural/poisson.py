@@ -224,6 +224,11 @@ class PoissonSolver:
         ``"periodic"``: the unit cube is a 3-torus (Eq. 8-10). ``"dirichlet"``:
         f = 0 on the cube's walls: f in sines, exact projections by dense
         per-axis transforms (:meth:`_solve_sine`).
+    lowpass : float
+        Standard deviation, in grid cells, of a Gaussian low-pass applied to f in
+        the same spectral solve (each mode scaled by ``exp(-omega^2 s^2 / 2)``,
+        ``omega`` its angular frequency, ``s = lowpass / res``); 0: none. Not in
+        the paper; the solver of Shape As Points (Peng et al. 2021) has one.
 
     Notes
     -----
@@ -241,10 +246,13 @@ class PoissonSolver:
     0.0
     """
 
-    def __init__(self, res: int, *, device="cpu", dtype=torch.float32, boundary: str = "periodic"):
+    def __init__(self, res: int, *, device="cpu", dtype=torch.float32, boundary: str = "periodic",
+                 lowpass: float = 0.0):
         if boundary not in ("periodic", "dirichlet"):
             raise ValueError(f"boundary must be 'periodic' or 'dirichlet', got {boundary!r}")
-        self.res, self.boundary = int(res), boundary
+        if not lowpass >= 0:
+            raise ValueError(f"lowpass must be >= 0 cells, got {lowpass!r}")
+        self.res, self.boundary, self.lowpass = int(res), boundary, float(lowpass)
         self.device, self.dtype = device, dtype
         if boundary == "dirichlet":
             self._init_sine()
@@ -260,7 +268,7 @@ class PoissonSolver:
             + (torch.fft.fftfreq(n, d=1.0 / n, dtype=torch.float64) ** 2).view(1, n, 1) \
             + (torch.fft.rfftfreq(n, d=1.0 / n, dtype=torch.float64) ** 2).view(1, 1, -1)
         inv = torch.where(uu > 0, 1.0 / (-2.0 * math.pi * uu.clamp(min=TINY_F32)),
-                          torch.zeros_like(uu))
+                          torch.zeros_like(uu)) * self._gain(4.0 * uu)
         # i u / (-2 pi |u|^2) per axis: (3, n, n, n//2+1), complex, stored so (a real
         # operator would be converted to complex on every multiply)
         op = torch.stack([(ux * inv).expand(n, n, -1), (uy * inv).expand(n, n, -1),
@@ -282,12 +290,18 @@ class PoissonSolver:
         C = torch.cos(math.pi * k[:-1, None] * i[None] / n)               # modes 1..n-1
         Cp = torch.cat([C / (C * C).sum(1, keepdim=True), torch.zeros(1, n, dtype=torch.float64)])
         kk = k.view(n, 1, 1) ** 2 + k.view(1, n, 1) ** 2 + k.view(1, 1, n) ** 2
-        inv = 1.0 / (math.pi * kk)
+        inv = self._gain(kk) / (math.pi * kk)
 
         def put(t):
             return t.to(device=self.device, dtype=self.dtype).contiguous()
         self._synth, self._sin_proj = put(S.T), put(S / (S * S).sum(1, keepdim=True))
         self._cos_proj, self._k, self._inv = put(Cp), put(k), put(inv)
+
+    def _gain(self, kk: torch.Tensor) -> torch.Tensor:
+        """The low-pass's gain of the modes ``sin / cos(pi k x)`` with ``kk = |k|^2``
+        (a periodic mode of ``u`` cycles per unit has ``k = 2 u``)."""
+        s = self.lowpass / self.res
+        return torch.exp(-0.5 * (math.pi * s) ** 2 * kk)
 
     def solve(self, g_grid: torch.Tensor) -> torch.Tensor:
         """Integrate a gradient grid.

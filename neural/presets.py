@@ -39,6 +39,14 @@ from the paper in:
   surfaces between their strokes, and the polish takes that back where it does not
   move the surface off the strokes.
 
+No preset low-passes the Poisson solve (``lowpass``, off as in the paper). At 128^3 a
+step's surface samples are sparser per cell than at 64^3, and where no stroke holds the
+field (the hole of a torus drawn as a few exact meridians and rings) the sign of f flips
+from step to step, so ``default``'s last step can wall the hole; ``lowpass=2`` keeps it
+open, but it takes parts of real sketches off their strokes, so it is a setting for
+sparse clean wireframes, not a preset's (figures: ``benchmarks/README.md``, "A low-pass
+in the Poisson solve").
+
 Both also fair the extracted mesh onto the strokes (``attach``): the zero set carries
 the splats' Monte-Carlo lumps and lies off rough strokes, which the fields' extra
 training does not take away. Ripples shorter than about 16 % of the padded box's side
@@ -92,6 +100,12 @@ class FlowConfig:
         watertight). ``"dirichlet"`` makes the walls outside, so every surface
         closes inside the box, but nothing in the energy puts the closure at the
         strokes' rims: such ends close as domes in the padding.
+    lowpass : float
+        Standard deviation, in grid cells, of a Gaussian low-pass of every Poisson
+        solve (training and polish; :class:`neural.poisson.PoissonSolver`); 0 (every
+        preset, as the paper): none. 2 at ``default`` keeps the holes of sparse
+        wireframes open and takes parts of real sketches off their strokes (notes
+        above).
     width, hidden_layers : int
         SIREN hidden width and number of hidden (width -> width) layers
         (paper: 256 and 4, Sec. 4.4).
@@ -178,6 +192,7 @@ class FlowConfig:
     res: int = 128
     padding: float = 0.2
     boundary: str = "periodic"
+    lowpass: float = 0.0
     width: int = 96
     hidden_layers: int = 2
     omega_0: float = 30.0
@@ -289,7 +304,8 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
         if not getattr(cfg, name) > 0:
             raise ValueError(f"{name} must be positive, got {getattr(cfg, name)!r}")
     for name in ("w_align", "w_smooth", "w_data", "w_eik", "w_curl", "w_normal", "grad_clip",
-                 "polish_strip", "attach", "attach_weight", "attach_band", "attach_reach"):
+                 "polish_strip", "attach", "attach_weight", "attach_band", "attach_reach",
+                 "lowpass"):
         if not getattr(cfg, name) >= 0:
             raise ValueError(f"{name} must be non-negative, got {getattr(cfg, name)!r}")
     for name in ("normalize_from", "average_from"):

@@ -80,6 +80,30 @@ def test_dirichlet_solve_high_modes_and_gradcheck():
     assert torch.autograd.gradcheck(lambda t: small.solve(t).sum(-1), (gg,))
 
 
+def test_lowpass_is_a_gaussian_filter_of_the_solution():
+    # the low-passed solve of an exact gradient is f blurred by a Gaussian of that many
+    # cells: periodic, against scipy's spatial filter with wrapped edges; Dirichlet, a
+    # single sine mode scaled by the Gaussian's gain at its frequency
+    from scipy.ndimage import gaussian_filter
+    n, cells = 32, 1.5
+    X, Y, Z = _grid(n)
+    f, g = _periodic_f(X, Y, Z)
+    fr = PoissonSolver(n, dtype=torch.float64, lowpass=cells).solve(g).numpy()
+    blurred = gaussian_filter((f - f.mean()).numpy(), cells, mode="wrap", truncate=6.0)
+    assert abs(fr - blurred).max() < 2e-3 * abs(blurred).max()
+    assert abs(fr - (f - f.mean()).numpy()).max() > 0.1 * abs(blurred).max()
+    p = math.pi
+    f = torch.sin(p * X) * torch.sin(2 * p * Y) * torch.sin(p * Z)
+    g = torch.stack([p * torch.cos(p * X) * torch.sin(2 * p * Y) * torch.sin(p * Z),
+                     2 * p * torch.sin(p * X) * torch.cos(2 * p * Y) * torch.sin(p * Z),
+                     p * torch.sin(p * X) * torch.sin(2 * p * Y) * torch.cos(p * Z)])
+    fr = PoissonSolver(n, dtype=torch.float64, boundary="dirichlet", lowpass=cells).solve(g)
+    gain = math.exp(-0.5 * (p * cells / n) ** 2 * 6)          # mode k = (1, 2, 1)
+    assert (fr - gain * f).abs().max() < 1e-10
+    with pytest.raises(ValueError, match="lowpass"):
+        PoissonSolver(8, lowpass=-1.0)
+
+
 def test_solver_rejects_bad_shape():
     with pytest.raises(ValueError, match="g_grid"):
         PoissonSolver(8).solve(torch.zeros(3, 8, 8, 9))
