@@ -24,7 +24,8 @@ heldout    ``--reference-quality`` on smooth closed sketches the presets were no
 wireframes ``--reference-quality`` and ``draft`` on clean sparse wireframes whose true surface
            is known (the curves of the network, exact, no noise): tori of 4 meridians x 2
            rings (tube radius 0.25 and 0.4) and 3 x 2 (0.4), and 3 great circles of a
-           sphere; F-score at 0.01 and Chamfer against the true surface
+           sphere, each with the fit seeds ``--fit-seeds`` (default 0); F-score at 0.01 and
+           Chamfer against the true surface
 vns        time and stroke fidelity per sketch (``--vns-quality``, default draft) on
            several vns sketches (``--vns all``: every ``*.obj`` under sketches/vns), PNG
            previews under ``--png-dir`` (default /tmp); fidelity is the share of stroke
@@ -51,6 +52,7 @@ The machine is shared: note the load average printed with the table.
 from __future__ import annotations
 
 import argparse
+import itertools
 import json
 import os
 import subprocess
@@ -94,7 +96,7 @@ def _worker(spec: dict) -> dict:
     t, cpu = time.perf_counter(), time.process_time()
     device = spec.get("device", "cpu")
     r = fit_flow_surface(strokes, labels=labels, quality=spec["quality"], progress=False,
-                         device=device, **spec.get("overrides", {}))
+                         device=device, seed=spec.get("fit_seed", 0), **spec.get("overrides", {}))
     out["time_s"] = time.perf_counter() - t
     out["timings"] = r.timings
     out["steps"] = r.report["steps"]
@@ -243,6 +245,8 @@ def main(argv=None):
                     help="preset of the rough-sphere comparison (default: default)")
     ap.add_argument("--seeds", type=int, nargs="*", default=[0, 1, 2, 3, 4],
                     help="rough-sphere sketch seeds of the spheres section")
+    ap.add_argument("--fit-seeds", type=int, nargs="*", default=[0],
+                    help="seeds of the fit itself in the wireframes section")
     ap.add_argument("--timeout", type=float, default=3600,
                     help="seconds per rough sphere of the spheres section (loaded machines: more)")
     ap.add_argument("--set", nargs="*", default=[], metavar="NAME=VALUE",
@@ -315,16 +319,16 @@ def main(argv=None):
                      f"{r['fscore']:.4f}", f"{r['chamfer']:.2e}",
                      f"{r.get('fidelity', 0.0):.3f}", f"{r['time_s']:.1f}s")
     if "wireframes" in a.only:
-        _row("wireframes", "shape", "quality", "F-score@0.01", "Chamfer", "wall")
-        for name in WIREFRAMES:
+        _row("wireframes", "shape", "quality", "fit seed", "F-score@0.01", "Chamfer", "wall")
+        for name, seed in itertools.product(WIREFRAMES, a.fit_seeds):
             for quality in ("draft", a.reference_quality):
                 r = _run({**base, "kind": "wireframe", "shape": name, "quality": quality,
-                          "overrides": overrides}, timeout=a.timeout)
+                          "fit_seed": seed, "overrides": overrides}, timeout=a.timeout)
                 if "error" in r:
-                    _row("wireframes", name, quality, r["error"])
+                    _row("wireframes", name, quality, seed, r["error"])
                     continue
-                _row("wireframes", name, quality, f"{r['fscore']:.4f}", f"{r['chamfer']:.2e}",
-                     f"{r['time_s']:.1f}s")
+                _row("wireframes", name, quality, seed, f"{r['fscore']:.4f}",
+                     f"{r['chamfer']:.2e}", f"{r['time_s']:.1f}s")
     if "vns" in a.only:
         names = a.vns
         if names == ["all"]:

@@ -4,12 +4,14 @@ Run from the repository root::
 
     nice -n 5 python benchmarks/bench_smoothness.py --out smooth.tsv
         [--sketches vns/torus,cassie/01-0-1] [--quality draft] [--threads 2] [--meshes DIR]
+        [--set lowpass=0 ...]
 
 Each sketch (default: the 22 of ``$CURVENET_DATA/sketches/vns``, ``input/`` included;
 ``--sketches`` takes ``SET/STEM`` names of ``vns``, ``cassie`` and ``networks``, the
 public clean curve networks: ``networks/haopan/loftbug``; a set's name alone takes all
 of it) is surfaced twice:
-``curvenet.surface(path, method="classical")`` and ``method="neural"`` at ``--quality``.
+``curvenet.surface(path, method="classical")`` and ``method="neural"`` at ``--quality``
+(with the :class:`neural.presets.FlowConfig` fields of ``--set`` over the preset).
 One row per sketch (appended as soon as it is done): for each surface the seconds, the
 stroke fidelity of the surface alone (share of stroke length within 1% of the sketch's
 diagonal, :func:`curvenet.evaluate.sketch_fidelity`) and the roughness
@@ -32,6 +34,7 @@ import numpy as np
 
 import curvenet
 from curvenet.evaluate import evaluate_mesh, roughness, sketch_fidelity
+from curvenet.neural.presets import parse_setting
 
 DATA = Path(os.environ.get("CURVENET_DATA",
                            Path(__file__).resolve().parents[1].parent / "shared" / "data"))
@@ -48,12 +51,13 @@ def _measure(res):
     return fid, 1000 * r["median"], 1000 * r["p90"]
 
 
-def _row(name: str, path: Path, quality: str, meshes: Path | None = None) -> dict:
+def _row(name: str, path: Path, quality: str, meshes: Path | None = None,
+         settings: dict | None = None) -> dict:
     t = time.perf_counter()
     cla = curvenet.surface(path, method="classical")
     t_c = time.perf_counter() - t
     t = time.perf_counter()
-    neu = curvenet.surface(path, method="neural", quality=quality)
+    neu = curvenet.surface(path, method="neural", quality=quality, neural_options=settings)
     t_n = time.perf_counter() - t
     if meshes is not None:
         for route, res in (("classical", cla), ("neural", neu)):
@@ -86,7 +90,10 @@ def main() -> None:
     ap.add_argument("--threads", type=int, default=0, help="torch threads (0: torch's)")
     ap.add_argument("--meshes", type=Path, default=None,
                     help="folder for both surfaces of each sketch (SET_STEM_ROUTE.ply)")
+    ap.add_argument("--set", nargs="*", default=[], metavar="NAME=VALUE",
+                    help="FlowConfig fields over the preset, e.g. lowpass=0")
     args = ap.parse_args()
+    settings = dict(parse_setting(t) for t in args.set)
     if args.threads:
         import torch
         torch.set_num_threads(args.threads)
@@ -98,7 +105,7 @@ def main() -> None:
     rows = []
     for name, path in _paths(list(filter(None, args.sketches.split(","))) or ["vns"]):
         try:
-            row = _row(name, path, args.quality, args.meshes)
+            row = _row(name, path, args.quality, args.meshes, settings)
         except Exception as err:  # noqa: BLE001 - a failed sketch is a row, not the end
             row = dict.fromkeys(COLUMNS, "-") | {"sketch": f"{name}: {err}"[:80]}
         rows.append(row)
