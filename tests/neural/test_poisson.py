@@ -25,6 +25,16 @@ def _periodic_f(X, Y, Z):
     return f, g
 
 
+def _sine_mode(X, Y, Z):
+    """f = sin(pi x) sin(2 pi y) sin(pi z), zero on the walls (mode k = (1, 2, 1)), and g."""
+    p = math.pi
+    f = torch.sin(p * X) * torch.sin(2 * p * Y) * torch.sin(p * Z)
+    g = torch.stack([p * torch.cos(p * X) * torch.sin(2 * p * Y) * torch.sin(p * Z),
+                     2 * p * torch.sin(p * X) * torch.cos(2 * p * Y) * torch.sin(p * Z),
+                     p * torch.sin(p * X) * torch.sin(2 * p * Y) * torch.cos(p * Z)])
+    return f, g
+
+
 @pytest.mark.parametrize("dtype,tol", [(torch.float64, 1e-10), (torch.float32, 1e-4)])
 def test_fft_poisson_recovers_periodic_function(dtype, tol):
     # band-limited periodic f: the spectral solve of Eq. 10 is exact up to round-off;
@@ -51,11 +61,7 @@ def test_dirichlet_solve_recovers_function_zero_on_walls(n):
     # f = sin(pi x) sin(2 pi y) sin(pi z) vanishes on the walls but is not periodic
     # with period 1; the Dirichlet solve recovers it exactly (one sine mode)
     X, Y, Z = _grid(n)
-    p = math.pi
-    f = torch.sin(p * X) * torch.sin(2 * p * Y) * torch.sin(p * Z)
-    g = torch.stack([p * torch.cos(p * X) * torch.sin(2 * p * Y) * torch.sin(p * Z),
-                     2 * p * torch.sin(p * X) * torch.cos(2 * p * Y) * torch.sin(p * Z),
-                     p * torch.sin(p * X) * torch.sin(2 * p * Y) * torch.cos(p * Z)])
+    f, g = _sine_mode(X, Y, Z)
     fr = PoissonSolver(n, dtype=torch.float64, boundary="dirichlet").solve(g)
     assert (fr - f).abs().max() < 1e-10
     periodic = PoissonSolver(n, dtype=torch.float64).solve(g)
@@ -92,13 +98,9 @@ def test_lowpass_is_a_gaussian_filter_of_the_solution():
     blurred = gaussian_filter((f - f.mean()).numpy(), cells, mode="wrap", truncate=6.0)
     assert abs(fr - blurred).max() < 2e-3 * abs(blurred).max()
     assert abs(fr - (f - f.mean()).numpy()).max() > 0.1 * abs(blurred).max()
-    p = math.pi
-    f = torch.sin(p * X) * torch.sin(2 * p * Y) * torch.sin(p * Z)
-    g = torch.stack([p * torch.cos(p * X) * torch.sin(2 * p * Y) * torch.sin(p * Z),
-                     2 * p * torch.sin(p * X) * torch.cos(2 * p * Y) * torch.sin(p * Z),
-                     p * torch.sin(p * X) * torch.sin(2 * p * Y) * torch.cos(p * Z)])
+    f, g = _sine_mode(X, Y, Z)
     fr = PoissonSolver(n, dtype=torch.float64, boundary="dirichlet", lowpass=cells).solve(g)
-    gain = math.exp(-0.5 * (p * cells / n) ** 2 * 6)          # mode k = (1, 2, 1)
+    gain = math.exp(-0.5 * (math.pi * cells / n) ** 2 * 6)      # mode k = (1, 2, 1)
     assert (fr - gain * f).abs().max() < 1e-10
     with pytest.raises(ValueError, match="lowpass"):
         PoissonSolver(8, lowpass=-1.0)
