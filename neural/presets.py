@@ -10,12 +10,11 @@ Notes
 -----
 Flow presets:
 
-- ``draft``: a short CPU run (64^3 grid, a 2 x 64 SIREN, 40 + 100 steps), about a
-  minute per sketch on two cores.
+- ``draft``: a short CPU run (64^3 grid, a 2 x 64 SIREN, 40 + 100 steps), seconds per
+  sketch on two cores.
 - ``default``: 128^3 and a 2 x 96 SIREN, 60 + 140 steps, then the polish; the better
-  choice on a GPU as well. (200 full steps before: the reference rough sphere took 51 s
-  on two cores for the same F-score and Chamfer, and the vns sketches' median stroke
-  fidelity was 95.2% against 95.1%; ``benchmarks/README.md``.)
+  choice on a GPU as well. 140 full steps rather than 200: the same F-score, Chamfer
+  distance and stroke fidelity in less time (``benchmarks/README.md``).
 - ``paper``: the published settings (Sec. 4.3, 5.1, 5.2): a 4 x 256 SIREN with
   omega_0 = 30, 10k / 15k / 15k Monte-Carlo samples on strokes, surface and volume,
   200 initialisation + 800 full Adam steps, a 256^3 grid on the bounding box padded by
