@@ -49,7 +49,9 @@ def roughness(mesh, *, radius: float = ROUGHNESS_RADIUS, n_centres: int = 4000,
     dict
         ``median`` and ``p90``: the RMS residual of the quadric fit divided by the
         ball's radius, over the centres (dimensionless; 0 for any quadric surface);
-        ``centres`` (the centres with enough samples), ``radius`` (model units).
+        ``centres`` (the number of centres with enough samples), ``values`` ((c,)
+        float64, each such centre's figure) and ``points`` ((c, 3) float64, those
+        centres), ``radius`` (model units).
 
     Raises
     ------
@@ -77,7 +79,8 @@ def roughness(mesh, *, radius: float = ROUGHNESS_RADIUS, n_centres: int = 4000,
     keep = w.sum(axis=1) >= _MIN_NEIGHBOURS
     w, idx = w[keep], idx[keep]
     if not len(w):
-        return {"median": float("nan"), "p90": float("nan"), "centres": 0, "radius": r}
+        return {"median": float("nan"), "p90": float("nan"), "centres": 0,
+                "values": np.zeros(0), "points": np.zeros((0, 3)), "radius": r}
     q = pts[idx] - centres[keep][:, None, :]                  # (c, k, 3)
     cnt = w.sum(axis=1)
     mean = np.einsum("ck,ckd->cd", w, q) / cnt[:, None]
@@ -93,4 +96,4 @@ def roughness(mesh, *, radius: float = ROUGHNESS_RADIUS, n_centres: int = 4000,
     res = h - np.einsum("cki,ci->ck", A, coef)
     rms = np.sqrt(np.einsum("ck,ck->c", w, res * res) / cnt)
     return {"median": float(np.median(rms)), "p90": float(np.percentile(rms, 90)),
-            "centres": int(len(rms)), "radius": r}
+            "centres": int(len(rms)), "values": rms, "points": centres[keep], "radius": r}

@@ -47,6 +47,19 @@ def test_a_crease_shows_in_the_upper_percentile_only():
     assert r["median"] < 1e-6 and r["p90"] > 0.02
 
 
+def test_each_centre_is_reported_where_it_is():
+    # the unit box's faces are flat: the centres whose ball holds a crease are those
+    # within the ball's radius of an edge, where two coordinates are near +-0.5
+    box = trimesh.creation.box().subdivide().subdivide().subdivide()
+    r = roughness(box, n_centres=2000)
+    values, points = r["values"], r["points"]
+    assert values.shape == (r["centres"],) and points.shape == (r["centres"], 3)
+    assert np.median(values) == r["median"]
+    gap = np.sort(0.5 - np.abs(points), axis=1)[:, 1]     # distance to the nearest edge
+    assert (gap[values > 0.02] < r["radius"]).all()
+    assert (values[gap > r["radius"]] < 1e-6).all()
+
+
 @pytest.mark.parametrize("kw", [dict(radius=0.0), dict(radius=0.7), dict(n_centres=0)])
 def test_bad_options_are_refused(kw):
     with pytest.raises(InvalidParameterError):
