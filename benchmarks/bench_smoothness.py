@@ -50,11 +50,10 @@ COLUMNS = ("sketch", "classical_s", "classical_fid", "classical_rough", "classic
 def _measure(res):
     from scipy.spatial import cKDTree
 
-    from curvenet.core.geometry import densify_polyline
+    from curvenet.core.geometry import densify_polylines
     fid = sketch_fidelity(res.mesh, res.sketch)["surface"]
     r = roughness(res.mesh)
-    samples = np.concatenate([densify_polyline(np.asarray(s, np.float64), r["radius"] / 4)
-                              for s in res.sketch.strokes])
+    samples = densify_polylines(res.sketch.strokes, r["radius"] / 4)[0]
     away = cKDTree(samples).query(r["points"])[0] > r["radius"]
     return (fid, 1000 * r["median"], 1000 * r["p90"],
             1000 * np.median(r["values"][away]) if away.any() else float("nan"))
