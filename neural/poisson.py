@@ -79,14 +79,40 @@ def splat(points: torch.Tensor, values: torch.Tensor, res: int, weights=None):
     idx, w, _, _ = trilinear_stencil(points.detach(), res)
     if weights is not None:
         w = w * weights.detach().to(w.dtype).unsqueeze(-1)
-    C = values.shape[1]
+    w = w.to(values.dtype)
     flat = idx.reshape(-1)
-    src = (w.unsqueeze(-1) * values.unsqueeze(1)).reshape(-1, C)  # (M*8, C)
-    grid = torch.zeros(res ** 3, C, dtype=values.dtype, device=values.device)
-    grid = grid.index_add(0, flat, src)
     wsum = torch.zeros(res ** 3, dtype=values.dtype, device=values.device)
-    wsum = wsum.index_add(0, flat, w.reshape(-1).to(values.dtype))
-    return grid.t().reshape(C, res, res, res), wsum.reshape(res, res, res)
+    wsum.index_add_(0, flat, w.reshape(-1))
+    return _Splat.apply(values, w, flat, res), wsum.view(res, res, res)
+
+
+class _Splat(torch.autograd.Function):
+    """The splat's sums, written channel by channel into one contiguous (C, res^3) grid.
+
+    Autograd's own splat (an out-of-place ``index_add`` into a (res^3, C) grid) copies
+    the grid once more, and hands the FFT a grid whose channels are strided by C, which
+    torch's CPU transform copies again. Here the grid is made channel-major in place,
+    and the backward gathers each channel's gradient, then weighs and sums the eight
+    corners of each point in the order autograd's backward does, so the gradient is the
+    same bit for bit. Twice differentiable (the backward is made of torch operations).
+    """
+
+    @staticmethod
+    def forward(ctx, values, w, flat, res):
+        C, n3 = values.shape[1], res ** 3
+        src = (w.unsqueeze(-1) * values.unsqueeze(1)).permute(2, 0, 1).reshape(-1)
+        chan = flat + n3 * torch.arange(C, device=flat.device).unsqueeze(1)   # (C, M*8)
+        grid = torch.zeros(C * n3, dtype=values.dtype, device=values.device)
+        grid.index_add_(0, chan.reshape(-1), src)
+        ctx.save_for_backward(w, flat)
+        return grid.view(C, res, res, res)
+
+    @staticmethod
+    def backward(ctx, grad):
+        w, flat = ctx.saved_tensors
+        C = grad.shape[0]
+        g = grad.reshape(C, -1).index_select(1, flat).t().contiguous().view(-1, 8, C)
+        return (g * w.unsqueeze(-1)).sum(1), None, None, None
 
 
 def stroke_strip(x_s, x_u, width: float):
