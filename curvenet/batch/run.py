@@ -136,7 +136,8 @@ class BatchResult:
 
 # --------------------------------------------------------------------------- the task
 def surface_task(path: str, data: bytes | None, options: BatchOptions, *,
-                 preview: bool = False, tile: bool = False, up: str = "z") -> dict:
+                 preview: bool = False, tile: bool = False, up: str = "z",
+                 scratch: str | None = None) -> dict:
     """Surface one input file; never raises for the file (only KeyboardInterrupt).
 
     Parameters
@@ -151,6 +152,9 @@ def surface_task(path: str, data: bytes | None, options: BatchOptions, *,
         Also render a full preview PNG / a small one-view tile for a contact sheet.
     up : {"z", "y", "x"}
         Up axis of the pictures.
+    scratch : str or None
+        Folder in which the task makes its private working folder (default: the
+        system's temporary folder).
 
     Returns
     -------
@@ -160,7 +164,7 @@ def surface_task(path: str, data: bytes | None, options: BatchOptions, *,
     """
     t0 = time.perf_counter()
     row: dict = {"input": path, "worker": _worker_name()}
-    with tempfile.TemporaryDirectory(prefix="curvenet-batch-") as tmp:
+    with tempfile.TemporaryDirectory(prefix="curvenet-batch-", dir=scratch) as tmp:
         local = path
         if data is not None:  # contents sent to this worker: same name, private folder
             local = os.path.join(tmp, os.path.basename(path))
@@ -296,7 +300,9 @@ class LocalExecutor:
     Tasks carry paths. When a pool process dies (a crash in native code, the kernel's
     out-of-memory killer), the whole pool breaks; the unfinished tasks then run one per
     fresh process (``jobs`` at a time), so a crash costs only its own file, which is
-    reported as ``internal``. Workers exit when this process dies.
+    reported as ``internal``. Workers exit when this process dies. The pool's tasks
+    make their working folders in one that this process removes when the batch ends,
+    so a worker that dies leaves none behind.
     """
 
     def __init__(self, jobs: int = 1):
@@ -314,19 +320,21 @@ class LocalExecutor:
         from concurrent.futures import ThreadPoolExecutor, as_completed
         from concurrent.futures.process import BrokenProcessPool
         broken = []
-        with _pool(self.jobs) as pool:
-            futures = {pool.submit(surface_task, path, None, options, **render): i
-                       for i, path in enumerate(tasks)}
-            for fut in as_completed(futures):
-                try:
+        with tempfile.TemporaryDirectory(prefix="curvenet-batch-") as scratch:
+            render = dict(render, scratch=scratch)
+            with _pool(self.jobs) as pool:
+                futures = {pool.submit(surface_task, path, None, options, **render): i
+                           for i, path in enumerate(tasks)}
+                for fut in as_completed(futures):
+                    try:
+                        yield futures[fut], fut.result()
+                    except BrokenProcessPool:
+                        broken.append(futures[fut])
+            with ThreadPoolExecutor(self.jobs) as threads:
+                futures = {threads.submit(_isolated, tasks[i], options, render): i
+                           for i in sorted(broken)}
+                for fut in as_completed(futures):
                     yield futures[fut], fut.result()
-                except BrokenProcessPool:
-                    broken.append(futures[fut])
-        with ThreadPoolExecutor(self.jobs) as threads:
-            futures = {threads.submit(_isolated, tasks[i], options, render): i
-                       for i in sorted(broken)}
-            for fut in as_completed(futures):
-                yield futures[fut], fut.result()
 
 
 def _isolated(path: str, options: BatchOptions, render: dict) -> dict:

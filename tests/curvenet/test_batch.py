@@ -10,6 +10,7 @@ import subprocess
 import sys
 import threading
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -151,28 +152,35 @@ def test_report_rows_and_contact_sheet(tmp_path):
         "box.png", "capped_cylinder.png", "contact_sheet.png", "house.png", "l_prism.png"]
 
 
-def _crashing_task(path, data, options, **kw):
-    """``surface_task``, but the process dies (as in a native crash) on house.obj."""
-    if path.endswith("house.obj"):
+def _crashing_file(local, options, tmp, **kw):
+    """``_surface_file``, but the process dies (as in a native crash) on house.obj, in
+    the middle of its task, with its working folder made and a file in it."""
+    if local.endswith("house.obj"):
+        Path(tmp, "partial.obj").write_text("v 0 0 0\n")
         os._exit(3)
-    return _REAL_TASK(path, data, options, **kw)
+    return _REAL_FILE(local, options, tmp, **kw)
 
 
-_REAL_TASK = __import__("curvenet.batch.run").batch.run.surface_task
+_REAL_FILE = __import__("curvenet.batch.run").batch.run._surface_file
 
 
 @pytest.mark.skipif(__import__("multiprocessing").get_start_method() != "fork",
                     reason="the crash is injected into forked pool processes")
 def test_a_pool_process_that_dies_costs_only_its_own_file(tmp_path, monkeypatch):
+    import tempfile
+
     import curvenet.batch.run
     from curvenet.batch.run import LocalExecutor
     inputs = _shapes(tmp_path / "in") + _boxes(tmp_path / "in", 2)
-    monkeypatch.setattr(curvenet.batch.run, "surface_task", _crashing_task)
+    monkeypatch.setattr(curvenet.batch.run, "_surface_file", _crashing_file)
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path / "tmp"))
+    (tmp_path / "tmp").mkdir()
     res = run_batch(inputs, tmp_path / "out", _opts(),
                     executor=LocalExecutor(2))
     status = {os.path.basename(r["input"]): r["status"] for r in res.rows}
     assert status.pop("house.obj") == "internal"
     assert set(status.values()) == {"ok"} and res.exit_code == 1
+    assert list((tmp_path / "tmp").iterdir()) == []   # the dead worker's folder is gone
 
 
 # --------------------------------------------------------------------------- resuming
