@@ -32,18 +32,7 @@ vns        time and stroke fidelity per sketch (``--vns-quality``, default draft
            length within 1 % of the sketch's diagonal of the surface, as ``curvenet eval``
            reports it (:func:`curvenet.core.fidelity.sketch_fidelity`)
 
-Measured 2026-11-24 on the shared 2-core CPU (load average 3-7 from other engineers;
-alone, draft takes ~12-16 s per sketch, as phone_flowrep/trebol show):
-draft100 gamepad (108 strokes) 238 s; vns draft: bulbasaur 571 s (under load),
-phone_flowrep 16.3 s, trebol_flowrep 15.7 s; s/step full stage: default 10.0 (128^3),
-29.6 (256^3); paper 62.6 (128^3), 42.9 (256^3) (2-step runs, first-step overhead
-and load included); reference sphere (18 strokes), default: 590 s, 1.01 GB,
-F 0.833, Chamfer 5.2e-3 vs published code 1320 s, 13.8 GB, F 0.998, 2.6e-3.
-
-On one H100 (``--device cuda``, 2026-11-24): 0.05-0.06 s per full step for default
-and paper at 128^3 and 256^3; paper 51-57 s per vns sketch, default 12-13 s; the
-rough sphere at paper 56 s (F 0.62-0.70), at default 7.7 s (F 0.999). See
-benchmarks/README.md.
+Figures, with their dates and machines, are in benchmarks/README.md.
 
 Each measurement runs in a fresh subprocess so that peak memory (ru_maxrss) is its own.
 The machine is shared: note the load average printed with the table.
