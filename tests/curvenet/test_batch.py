@@ -8,6 +8,7 @@ import os
 import signal
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 from pathlib import Path
@@ -30,6 +31,17 @@ COARSE = ["--edge-length", "0.03"]
 
 def _opts(**kw):
     return BatchOptions(method="classical", edge_length=0.03, **kw)
+
+
+@pytest.fixture(autouse=True)
+def scratch(tmp_path, monkeypatch):
+    """The temporary folder of this test and of the processes it starts: the working
+    folders of the batches and workers killed on purpose here stay out of /tmp."""
+    folder = tmp_path / "tmp"
+    folder.mkdir()
+    monkeypatch.setenv("TMPDIR", str(folder))
+    monkeypatch.setattr(tempfile, "tempdir", str(folder))
+    return folder
 
 
 def _boxes(folder, n):
@@ -166,21 +178,17 @@ _REAL_FILE = __import__("curvenet.batch.run").batch.run._surface_file
 
 @pytest.mark.skipif(__import__("multiprocessing").get_start_method() != "fork",
                     reason="the crash is injected into forked pool processes")
-def test_a_pool_process_that_dies_costs_only_its_own_file(tmp_path, monkeypatch):
-    import tempfile
-
+def test_a_pool_process_that_dies_costs_only_its_own_file(tmp_path, monkeypatch, scratch):
     import curvenet.batch.run
     from curvenet.batch.run import LocalExecutor
     inputs = _shapes(tmp_path / "in") + _boxes(tmp_path / "in", 2)
     monkeypatch.setattr(curvenet.batch.run, "_surface_file", _crashing_file)
-    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path / "tmp"))
-    (tmp_path / "tmp").mkdir()
     res = run_batch(inputs, tmp_path / "out", _opts(),
                     executor=LocalExecutor(2))
     status = {os.path.basename(r["input"]): r["status"] for r in res.rows}
     assert status.pop("house.obj") == "internal"
     assert set(status.values()) == {"ok"} and res.exit_code == 1
-    assert list((tmp_path / "tmp").iterdir()) == []   # the dead worker's folder is gone
+    assert list(scratch.iterdir()) == []   # the dead worker's folder went with the batch's
 
 
 # --------------------------------------------------------------------------- resuming
