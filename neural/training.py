@@ -16,6 +16,7 @@ runs are reproducible bit for bit.
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 from typing import Any, Callable
@@ -185,10 +186,8 @@ def train(params, stages, *, lr: float, grad_clip: float = 0.0, schedule: str = 
     if schedule not in ("constant", "cosine"):
         raise ValueError(f"schedule must be 'constant' or 'cosine', got {schedule!r}")
     params = list(params)
-    opt = torch.optim.Adam(params, lr=lr)
     total = sum(s.steps for s in stages)
-    sched = (torch.optim.lr_scheduler.CosineAnnealingLR(opt, total, eta_min=lr_min)
-             if schedule == "cosine" else None)
+    opt = _Adam(params, lr, cosine=(total, lr_min) if schedule == "cosine" else None)
     out = Training(None, False, {s.name: 0 for s in stages}, {s.name: 0.0 for s in stages}, {})
     bar = None
     if progress:
@@ -200,14 +199,12 @@ def train(params, stages, *, lr: float, grad_clip: float = 0.0, schedule: str = 
             if stage.start is not None:
                 _offer(out, stage.start(), keep)
             for k in range(stage.steps):
-                opt.zero_grad(set_to_none=True)
+                opt.zero_grad()
                 step = stage.step(k)
                 step.loss.backward()
                 if grad_clip > 0:
                     torch.nn.utils.clip_grad_norm_(params, grad_clip)
                 opt.step()
-                if sched is not None:
-                    sched.step()
                 if step.after is not None:
                     step.after()
                 _offer(out, step.state, keep)
@@ -225,6 +222,59 @@ def train(params, stages, *, lr: float, grad_clip: float = 0.0, schedule: str = 
         if bar is not None:
             bar.close()
     return out
+
+
+class _Adam:
+    """Adam with torch's defaults, and optionally the cosine decay of its learning rate.
+
+    The same values bit for bit as ``torch.optim.Adam`` (its single-tensor path, which
+    it takes on the CPU) followed by ``torch.optim.lr_scheduler.CosineAnnealingLR``'s
+    step (its recursive form): ``tests/neural/test_training.py`` runs both. Written out
+    because constructing a ``torch.optim`` optimiser imports TorchDynamo, about a second
+    of each process that fits, for a compiler these fits never use.
+
+    Parameters
+    ----------
+    params : list of torch parameters
+    lr : float
+    cosine : (int, float) or None
+        ``(total, lr_min)``: the rate falls from ``lr`` to ``lr_min`` over ``total`` steps
+        (no more are taken).
+    """
+
+    BETAS, EPS = (0.9, 0.999), 1e-8
+
+    def __init__(self, params, lr: float, cosine=None):
+        self.params, self.lr, self.cosine = params, lr, cosine
+        self.t = 0                                  # steps taken
+        self.moments: dict = {}
+
+    def zero_grad(self) -> None:
+        for p in self.params:
+            p.grad = None
+
+    def step(self) -> None:
+        import torch
+
+        b1, b2 = self.BETAS
+        self.t += 1
+        with torch.no_grad():
+            for p in self.params:
+                if p.grad is None:
+                    continue
+                if p not in self.moments:
+                    self.moments[p] = (torch.zeros_like(p), torch.zeros_like(p), [0])
+                m, v, count = self.moments[p]
+                count[0] += 1
+                m.lerp_(p.grad, 1 - b1)
+                v.mul_(b2).addcmul_(p.grad, p.grad, value=1 - b2)
+                denom = (v.sqrt() / (1 - b2 ** count[0]) ** 0.5).add_(self.EPS)
+                p.addcdiv_(m, denom, value=-(self.lr / (1 - b1 ** count[0])))
+        if self.cosine is not None:             # torch's recursive form, for t <= total
+            total, lr_min = self.cosine
+            self.lr = ((1 + math.cos(math.pi * self.t / total))
+                       / (1 + math.cos(math.pi * (self.t - 1) / total))
+                       * (self.lr - lr_min) + lr_min)
 
 
 def _offer(out: Training, state, keep) -> None:

@@ -134,3 +134,39 @@ def test_torch_device_rejects_what_is_not_here(device):
     with pytest.raises(ValueError, match="device"):
         torch_device(device)
     assert torch_device("cpu").type == "cpu"
+
+
+@pytest.mark.parametrize("schedule", ["constant", "cosine"])
+def test_a_network_trains_as_torch_optim_would_bit_for_bit(schedule):
+    """The loop's own Adam against ``torch.optim.Adam`` (and ``CosineAnnealingLR``) on a
+    small MLP with several parameter tensors, one of which has no gradient on odd steps."""
+    def fit(reference):
+        torch.manual_seed(5)
+        net = torch.nn.Sequential(torch.nn.Linear(3, 16), torch.nn.Tanh(), torch.nn.Linear(16, 1))
+        extra = torch.nn.Parameter(torch.randn(4))
+        params = [*net.parameters(), extra]
+        x = torch.randn(64, 3)
+
+        def loss(k):
+            value = (net(x) - x[:, :1] ** 2).pow(2).mean()
+            return value + (extra.pow(2).sum() if k % 2 == 0 else 0.0)
+
+        kw = {"schedule": "cosine", "lr_min": 1e-4} if schedule == "cosine" else {}
+        if reference:
+            opt = torch.optim.Adam(params, lr=0.01)
+            sched = (torch.optim.lr_scheduler.CosineAnnealingLR(opt, 40, eta_min=1e-4)
+                     if kw else None)
+            for k in range(40):
+                opt.zero_grad(set_to_none=True)
+                loss(k).backward()
+                torch.nn.utils.clip_grad_norm_(params, 0.5)
+                opt.step()
+                if sched is not None:
+                    sched.step()
+        else:
+            train(params, [Stage("a", 15, lambda k: Step(loss(k))),
+                           Stage("b", 25, lambda k: Step(loss(k + 15)))],
+                  lr=0.01, grad_clip=0.5, **kw)
+        return [p.detach().clone() for p in params]
+
+    assert all(torch.equal(a, b) for a, b in zip(fit(False), fit(True)))
