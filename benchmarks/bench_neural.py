@@ -251,6 +251,7 @@ def main(argv=None):
     base = {"threads": a.threads, "device": a.device}
     overrides = dict(parse_setting(t) for t in a.set)
     png = Path(a.png_dir)
+    png.mkdir(parents=True, exist_ok=True)   # before any fit, not after each
     vns = DATA / "sketches" / "vns"
     if "draft100" in a.only:
         path = vns / "input" / "gamepad.obj"
