@@ -262,14 +262,15 @@ class _Adam:
             for p in self.params:
                 if p.grad is None:
                     continue
-                if p not in self.moments:
-                    self.moments[p] = (torch.zeros_like(p), torch.zeros_like(p), [0])
-                m, v, count = self.moments[p]
-                count[0] += 1
+                if p not in self.moments:       # [first moment, second, own steps]
+                    self.moments[p] = [torch.zeros_like(p), torch.zeros_like(p), 0]
+                state = self.moments[p]
+                state[2] += 1
+                m, v, n = state
                 m.lerp_(p.grad, 1 - b1)
                 v.mul_(b2).addcmul_(p.grad, p.grad, value=1 - b2)
-                denom = (v.sqrt() / (1 - b2 ** count[0]) ** 0.5).add_(self.EPS)
-                p.addcdiv_(m, denom, value=-(self.lr / (1 - b1 ** count[0])))
+                denom = (v.sqrt() / (1 - b2 ** n) ** 0.5).add_(self.EPS)
+                p.addcdiv_(m, denom, value=-(self.lr / (1 - b1 ** n)))
         if self.cosine is not None:             # torch's recursive form, for t <= total
             total, lr_min = self.cosine
             self.lr = ((1 + math.cos(math.pi * self.t / total))
