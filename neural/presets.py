@@ -186,6 +186,11 @@ class FlowConfig:
         sized mesh off the surface's curvature (4 times the triangles a round). One round
         in ``draft`` and ``default``; none in ``paper`` (its 256^3 grid). Not with
         ``anchors``. Not in the paper.
+    split_parts : int
+        1: the route fits the separately drawn parts of a connected drawing one at a
+        time (:func:`neural.parts.fit_parts`; the paper does so by hand for one
+        sketch); 0: one fit of the whole sketch. 1 in ``draft`` and ``default``.
+        :func:`neural.flow.fit_flow_surface` itself always fits what it is given.
     """
 
     res: int = 128
@@ -223,6 +228,7 @@ class FlowConfig:
     attach_band: float = 0.0
     attach_reach: float = 3.0
     subdivide: int = 0
+    split_parts: int = 0
 
     def as_dict(self) -> dict:
         """The settings as a plain dict (for reports)."""
@@ -232,10 +238,12 @@ class FlowConfig:
 PRESETS: dict[str, FlowConfig] = {
     "draft": FlowConfig(res=64, width=64, hidden_layers=2, n_stroke=1200, n_surface=1000,
                         n_volume=600, init_steps=40, steps=100, lr=3e-4, poisson_every=1,
-                        w_smooth=0.1, attach=10.0, attach_band=0.005, subdivide=1),
+                        w_smooth=0.1, attach=10.0, attach_band=0.005, subdivide=1,
+                        split_parts=1),
     "default": FlowConfig(steps=140, w_smooth=0.1, polish=4, polish_rounds=4,
                           polish_strip=1.0, average_from=0.6, attach=20.0,
-                          attach_band=0.005, attach_reach=6.0, subdivide=1),
+                          attach_band=0.005, attach_reach=6.0, subdivide=1,
+                          split_parts=1),
     "paper": FlowConfig(res=256, width=256, hidden_layers=4, n_stroke=10000, n_surface=15000,
                         n_volume=15000, init_steps=200, steps=800, lr=5e-5,
                         geometric_init_steps=0),
@@ -290,6 +298,8 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
         v = getattr(cfg, name)
         if int(v) != v or v < 0:
             raise ValueError(f"{name} must be a non-negative integer, got {v!r}")
+    if cfg.split_parts not in (0, 1):
+        raise ValueError(f"split_parts must be 0 or 1, got {cfg.split_parts!r}")
     if int(cfg.subdivide) != cfg.subdivide or not 0 <= cfg.subdivide <= MAX_SUBDIVIDE:
         raise ValueError(f"subdivide must be an integer in [0, {MAX_SUBDIVIDE}], "
                          f"got {cfg.subdivide!r}")

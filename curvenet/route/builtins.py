@@ -97,15 +97,16 @@ def _check_neural(options: dict, settings: SurfaceSettings) -> None:
 
 
 def _neural(inp: SurfaceInput, options: dict) -> MeshResult:
-    """Flow-aligned implicit fit, then the crease refit when some strokes are creases."""
-    from ..neural import crease_refit, flow
+    """Flow-aligned implicit fit (part by part, :mod:`neural.parts`), then the crease refit
+    when some strokes are creases."""
+    from ..neural import crease_refit, parts
     s = inp.settings
     _check_device(s.device)
     flow_options = dict(options)
     crease_options = flow_options.pop("creases", None) or {}
-    res = flow.fit_flow_surface(inp.strokes, labels=inp.labels, quality=s.quality,
-                                device=s.device, seed=s.seed, init_mesh=inp.init_mesh,
-                                anchors=inp.anchors, progress=s.progress, **flow_options)
+    res = parts.fit_parts(inp.strokes, labels=inp.labels, quality=s.quality,
+                          device=s.device, seed=s.seed, init_mesh=inp.init_mesh,
+                          anchors=inp.anchors, progress=s.progress, **flow_options)
     verts, faces, report = res.vertices, res.faces, dict(res.report)
     if "crease" in inp.labels and not report.get("interrupted"):
         cres = crease_refit.crease_refine(verts, faces, inp.strokes, inp.labels, quality=s.quality,
