@@ -23,8 +23,10 @@ heldout    ``--reference-quality`` on smooth closed sketches the presets were no
            stroke fidelity
 wireframes ``--reference-quality`` and ``draft`` on clean sparse wireframes whose true surface
            is known (the curves of the network, exact, no noise): tori of 4 meridians x 2
-           rings (tube radius 0.25 and 0.4) and 3 x 2 (0.4), and 3 great circles of a
-           sphere, each with the fit seeds ``--fit-seeds`` (default 0); F-score at 0.01 and
+           rings (tube radius 0.25 and 0.4) and 3 x 2 (0.4), 3 great circles of a
+           sphere, and two such spheres 0.2 apart (fitted part by part,
+           :mod:`neural.parts`, as the route does: ``--set split_parts=0`` for one
+           field), each with the fit seeds ``--fit-seeds`` (default 0); F-score at 0.01 and
            Chamfer against the true surface
 vns        time and stroke fidelity per sketch (``--vns-quality``, default draft) on
            several vns sketches (``--vns all``: every ``*.obj`` under sketches/vns), PNG
@@ -63,8 +65,8 @@ def _worker(spec: dict) -> dict:
     import torch
     torch.set_num_threads(spec.get("threads", 2))
     sys.path.insert(0, str(ROOT))
-    from curvenet.neural.flow import fit_flow_surface
     from curvenet.model.sketch import Sketch
+    from curvenet.neural.parts import fit_parts
     out = {}
     if spec["kind"] == "sketch":
         from curvenet.io.sketch import read_sketch
@@ -76,18 +78,20 @@ def _worker(spec: dict) -> dict:
         sk = rough_sketch(shape.network, seed=spec.get("sketch_seed", 0), split=0.0,
                           overdraw=0.0)
     elif spec["kind"] == "wireframe":
-        shape = _wireframe(spec["shape"])
-        sk = Sketch([e.curve for e in shape.network.edges])
+        curves, ref = _wireframe(spec["shape"])
+        sk = Sketch(curves)
     else:
         shape, sk = _heldout_sketch(spec["shape"], spec["noise"], spec["sketch_seed"])
+    if spec["kind"] in ("sphere", "shape"):
+        ref = shape.reference_mesh(5)
     strokes, labels = sk.strokes, sk.labels
     out["strokes"] = len(strokes)
     t, cpu = time.perf_counter(), time.process_time()
     device = spec.get("device", "cpu")
-    r = fit_flow_surface(strokes, labels=labels, quality=spec["quality"], progress=False,
-                         device=device, seed=spec.get("fit_seed", 0), **spec.get("overrides", {}))
+    r = fit_parts(strokes, labels=labels, quality=spec["quality"], progress=False,
+                  device=device, seed=spec.get("fit_seed", 0), **spec.get("overrides", {}))
     out["time_s"] = time.perf_counter() - t
-    out["timings"] = r.timings
+    out["timings"] = getattr(r, "timings", {})        # one fit's (not parts fitted apart)
     out["steps"] = r.report["steps"]
     out["faces"] = len(r.faces)
     out["polish"] = _polish_column(r.report.get("polish"))
@@ -100,7 +104,6 @@ def _worker(spec: dict) -> dict:
         out["fidelity"] = sketch_fidelity((r.vertices, r.faces), sk)["surface"]
     if spec["kind"] != "sketch":
         from tests.neural._metrics import fscore
-        ref = shape.reference_mesh(5)
         out["fscore"], out["chamfer"] = fscore(r.vertices, r.faces, ref.vertices, ref.faces)
     if spec.get("png"):
         _render(r.vertices, r.faces, strokes, spec["png"])
@@ -108,17 +111,29 @@ def _worker(spec: dict) -> dict:
     return out
 
 
-WIREFRAMES = ["torus r0.25 4x2", "torus r0.4 4x2", "torus r0.4 3x2", "sphere 3 circles"]
+WIREFRAMES = ["torus r0.25 4x2", "torus r0.4 4x2", "torus r0.4 3x2", "sphere 3 circles",
+              "2 spheres gap0.2"]
 
 
 def _wireframe(name: str):
-    """The :class:`AnalyticShape` of a ``WIREFRAMES`` name."""
+    """``(curves, true surface (trimesh.Trimesh))`` of a ``WIREFRAMES`` name; ``2 spheres
+    gapG``: two unit spheres of 3 great circles each, ``G`` apart."""
+    import trimesh
+
     from curvenet.datasets import sections, shapes
+    if name.startswith("2 spheres"):
+        ball = sections.great_circles(3)
+        shift = [2.0 + float(name.split()[2][3:]), 0.0, 0.0]
+        curves = [e.curve for e in ball.network.edges]
+        return curves + [c + shift for c in curves], trimesh.util.concatenate(
+            [ball.reference_mesh(5), ball.reference_mesh(5).apply_translation(shift)])
     if name.startswith("sphere"):
-        return sections.great_circles(int(name.split()[1]))
-    _, r, counts = name.split()
-    meridians, rings = (int(k) for k in counts.split("x"))
-    return shapes.torus(1.0, float(r[1:]), n_u=meridians, n_v=rings)
+        shape = sections.great_circles(int(name.split()[1]))
+    else:
+        _, r, counts = name.split()
+        meridians, rings = (int(k) for k in counts.split("x"))
+        shape = shapes.torus(1.0, float(r[1:]), n_u=meridians, n_v=rings)
+    return [e.curve for e in shape.network.edges], shape.reference_mesh(5)
 
 
 HELDOUT = [("ellipsoid", "rough", 0), ("torus", "rough", 0), ("sphere", "tremor", 1),
