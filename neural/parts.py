@@ -26,8 +26,9 @@ Each part is fitted on a grid of the same cell size as the whole sketch's (its
 Monte-Carlo sample counts scaled to the same density (stroke samples by the
 part's share of the stroke length, surface ones by the square of the scale,
 volume ones by its cube; at least :data:`PART_MIN_SAMPLES` each), so every
-setting given in cells means what it means for the whole sketch and the parts
-together cost about what one fit of the whole costs.
+setting given in cells means what it means for the whole sketch. The grids and the
+samples of the parts together cost about what the whole's do, but every fit also pays
+the per-step cost of the network's backward, which does not shrink with the part.
 
 References
 ----------
@@ -162,27 +163,32 @@ def fit_parts(strokes, labels=None, *, quality: str = "draft", **kwargs):
     curvenet.core.MeshResult
         The parts' meshes together. With one part, the
         :class:`neural.flow.FlowResult` itself; with several, ``report`` is the
-        largest part's, with ``split`` the list of every part's ``strokes`` (indices),
+        largest part's, with ``split`` the list of every part's ``strokes`` (indices
+        into the strokes that are not ``construction`` strokes),
         ``settings`` (its ``res`` and sample counts) and ``report``, and the totals
         ``n_vertices``, ``n_faces`` and ``interrupted``.
     """
     from curvenet.core.result import MeshResult
 
-    from .flow import fit_flow_surface
+    from .flow import _check_strokes, fit_flow_surface
     from .presets import FlowConfig, get_config
     names = {f.name for f in fields(FlowConfig)}
     cfg = get_config(quality, **{k: v for k, v in kwargs.items() if k in names})
     whole = (not cfg.split_parts or kwargs.get("init_mesh") is not None
              or kwargs.get("anchors") is not None)
-    parts = [np.arange(len(strokes))] if whole else stroke_parts(strokes)
-    if len(parts) == 1:
+    parts = []
+    if not whole:
+        kept, kept_labels = _check_strokes(strokes, labels)     # construction strokes out
+        parts = stroke_parts(kept)
+    if len(parts) < 2:
         return fit_flow_surface(strokes, labels=labels, quality=quality, **kwargs)
+    strokes, labels = kept, kept_labels
     length = np.array([np.linalg.norm(np.diff(s, axis=0), axis=1).sum() for s in strokes])
     Vs, Fs, split, offset = [], [], [], 0
     for part in parts:
         settings = _part_settings(cfg, strokes, part, length)
         res = fit_flow_surface([strokes[i] for i in part], quality=quality,
-                               labels=None if labels is None else [labels[i] for i in part],
+                               labels=[labels[i] for i in part],
                                **{**kwargs, **settings})
         Vs.append(res.vertices)
         Fs.append(res.faces + offset)

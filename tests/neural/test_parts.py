@@ -91,3 +91,21 @@ def test_split_parts_off_or_a_refinement_fits_the_whole(monkeypatch):
     assert calls == [6, 6]
     with pytest.raises(ValueError, match="split_parts"):
         get_config("draft", split_parts=2)
+
+
+def test_construction_strokes_are_left_out_before_the_split(monkeypatch):
+    import curvenet.neural.flow as flow
+    from curvenet.core.result import MeshResult
+    calls = []
+
+    def fake(strokes, labels=None, **kw):
+        calls.append((len(strokes), list(labels), kw["res"]))
+        return MeshResult(np.vstack(strokes)[:3], [[0, 1, 2]], {"interrupted": False})
+
+    monkeypatch.setattr(flow, "fit_flow_surface", fake)
+    guide = np.array([[-5.0, 0, 0], [8.0, 0, 0]])        # through both balls
+    strokes = [guide] + _ball(np.zeros(3)) + _ball(np.array([2.2, 0, 0]))
+    res = fit_parts(strokes, ["construction"] + ["crease"] * 6, quality="draft")
+    assert calls == [(3, ["crease"] * 3, 32), (3, ["crease"] * 3, 32)]
+    assert [s["strokes"] for s in res.report["split"]] == [[0, 1, 2], [3, 4, 5]]
+    assert res.faces.tolist() == [[0, 1, 2], [3, 4, 5]]
