@@ -43,7 +43,7 @@ from dataclasses import fields
 import numpy as np
 
 from curvenet.core.fidelity import FIDELITY_TOL_REL
-from curvenet.core.geometry import bbox_diagonal, densify_polylines
+from curvenet.core.geometry import arc_length, bbox_diagonal, densify_polylines
 
 __all__ = ["stroke_parts", "fit_parts", "CONNECTED_ENDS", "PART_MIN_STROKES",
            "PART_MIN_THICKNESS", "PART_MIN_RES", "PART_MIN_SAMPLES"]
@@ -127,7 +127,7 @@ def stroke_parts(strokes) -> list:
     for g, p, s in zip(groups, points, solid):
         if not s:
             parts[int(np.argmin([t.query(p)[0].min() for t in trees]))].append(g)
-    length = np.array([np.linalg.norm(np.diff(s, axis=0), axis=1).sum() for s in strokes])
+    length = np.array([arc_length(s) for s in strokes])
     out = [np.sort(np.concatenate(p)) for p in parts]
     return sorted(out, key=lambda p: -length[p].sum())
 
@@ -183,7 +183,7 @@ def fit_parts(strokes, labels=None, *, quality: str = "draft", **kwargs):
     if len(parts) < 2:
         return fit_flow_surface(strokes, labels=labels, quality=quality, **kwargs)
     strokes, labels = kept, kept_labels
-    length = np.array([np.linalg.norm(np.diff(s, axis=0), axis=1).sum() for s in strokes])
+    length = np.array([arc_length(s) for s in strokes])
     Vs, Fs, split, offset = [], [], [], 0
     for part in parts:
         settings = _part_settings(cfg, strokes, part, length)
