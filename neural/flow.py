@@ -119,7 +119,7 @@ from .frame import Frame
 from .presets import FlowConfig, get_config
 from .training import torch_device, train
 
-__all__ = ["FlowResult", "fit_flow_surface"]
+__all__ = ["FlowResult", "fit_flow_surface", "fit_strokes"]
 
 
 @dataclass(repr=False, kw_only=True)
@@ -159,7 +159,18 @@ class FlowResult(MeshResult):
                            torch.from_numpy(u)).numpy()
 
 
-def _check_strokes(strokes, labels):
+def fit_strokes(strokes, labels):
+    """The strokes a fit uses: validated float64 copies, construction strokes left out.
+
+    Returns ``(strokes, labels)``; labels default to ``"crease"``.
+
+    Raises
+    ------
+    InvalidParameterError
+        A malformed stroke or label (:func:`curvenet.core.strokes.check_strokes`).
+    ValueError
+        Only construction strokes.
+    """
     out, labels = check_strokes(strokes, labels, default_label="crease", allow_empty=False)
     keep = [i for i, lab in enumerate(labels) if lab != "construction"]
     if not keep:
@@ -224,7 +235,7 @@ def fit_flow_surface(strokes, *, labels=None, quality: str = "draft", device="cp
     False
     """
     cfg = get_config(quality, **overrides)
-    strokes, labels = _check_strokes(strokes, labels)
+    strokes, labels = fit_strokes(strokes, labels)
     dev = torch_device(device)
     return _fit(strokes, labels, cfg, dev, int(seed), init_mesh, progress, cut_boundary, quality,
                 anchors=_check_anchors(anchors))

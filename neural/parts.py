@@ -170,7 +170,7 @@ def fit_parts(strokes, labels=None, *, quality: str = "draft", **kwargs):
     """
     from curvenet.core.result import MeshResult
 
-    from .flow import _check_strokes, fit_flow_surface
+    from .flow import fit_flow_surface, fit_strokes
     from .presets import FlowConfig, get_config
     names = {f.name for f in fields(FlowConfig)}
     cfg = get_config(quality, **{k: v for k, v in kwargs.items() if k in names})
@@ -178,7 +178,7 @@ def fit_parts(strokes, labels=None, *, quality: str = "draft", **kwargs):
              or kwargs.get("anchors") is not None)
     parts = []
     if not whole:
-        kept, kept_labels = _check_strokes(strokes, labels)     # construction strokes out
+        kept, kept_labels = fit_strokes(strokes, labels)
         parts = stroke_parts(kept)
     if len(parts) < 2:
         return fit_flow_surface(strokes, labels=labels, quality=quality, **kwargs)
