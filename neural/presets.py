@@ -56,6 +56,10 @@ pull alone (6 cells) leaves the surfaces several times rougher by the local-quad
 measure and further from the classical surfaces; a long cutoff with the pull alone lets
 the surface sag off its strokes (figures: ``benchmarks/README.md``).
 
+Both fit the separately drawn bodies of a connected drawing one at a time
+(``split_parts``, :mod:`neural.parts`): one field for the whole joins close bodies with
+a web that no stroke holds.
+
 Crease presets: ``draft`` for a CPU, ``default`` a 4 x 256 MLP trained 3,000 steps,
 ``paper`` the network size and the 15,000 steps of the paper's 3D examples (Sec. 5),
 with the Softplus activation of Sec. 4.
