@@ -122,11 +122,14 @@ def stroke_parts(strokes) -> list:
     if sum(solid) < 2:
         return everything
     from scipy.spatial import cKDTree
-    parts = [[g] for g, s in zip(groups, solid) if s]
-    trees = [cKDTree(p) for p, s in zip(points, solid) if s]
+    bodies = np.flatnonzero(solid)
+    parts = [[groups[i]] for i in bodies]
+    body_of = np.repeat(np.arange(len(bodies)), [len(points[i]) for i in bodies])
+    tree = cKDTree(np.vstack([points[i] for i in bodies]))
     for g, p, s in zip(groups, points, solid):
-        if not s:
-            parts[int(np.argmin([t.query(p)[0].min() for t in trees]))].append(g)
+        if not s:                                   # to the body nearest to any of its points
+            d, j = tree.query(p)
+            parts[body_of[j[np.argmin(d)]]].append(g)
     length = np.array([arc_length(s) for s in strokes])
     out = [np.sort(np.concatenate(p)) for p in parts]
     return sorted(out, key=lambda p: -length[p].sum())
