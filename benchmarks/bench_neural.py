@@ -125,8 +125,9 @@ def _wireframe(name: str):
         ball = sections.great_circles(3)
         shift = [2.0 + float(name.split()[2][3:]), 0.0, 0.0]
         curves = [e.curve for e in ball.network.edges]
+        sphere = ball.reference_mesh(5)
         return curves + [c + shift for c in curves], trimesh.util.concatenate(
-            [ball.reference_mesh(5), ball.reference_mesh(5).apply_translation(shift)])
+            [sphere, sphere.copy().apply_translation(shift)])
     if name.startswith("sphere"):
         shape = sections.great_circles(int(name.split()[1]))
     else:

@@ -135,13 +135,12 @@ def stroke_parts(strokes) -> list:
     return sorted(out, key=lambda p: -length[p].sum())
 
 
-def _part_settings(cfg, strokes, part, length) -> dict:
-    """``res`` and sample counts of one part's fit (module docstring)."""
-    whole = np.ptp(np.vstack(strokes), axis=0).max()
-    scale = np.ptp(np.vstack([strokes[i] for i in part]), axis=0).max() / whole
+def _part_settings(cfg, part_strokes, extent: float, share: float) -> dict:
+    """``res`` and sample counts of the fit of one part (module docstring), given the
+    whole sketch's longest side ``extent`` and the part's ``share`` of its stroke length."""
+    scale = np.ptp(np.vstack(part_strokes), axis=0).max() / extent
     res = int(min(cfg.res, max(PART_MIN_RES, 8 * np.ceil(cfg.res * scale / 8))))
     k = res / cfg.res
-    share = length[part].sum() / length.sum()
     counts = {"n_stroke": cfg.n_stroke * share, "n_surface": cfg.n_surface * k * k,
               "n_volume": cfg.n_volume * k ** 3}
     return {"res": res, **{name: int(max(PART_MIN_SAMPLES, round(n)))
@@ -179,18 +178,18 @@ def fit_parts(strokes, labels=None, *, quality: str = "draft", **kwargs):
     cfg = get_config(quality, **{k: v for k, v in kwargs.items() if k in names})
     whole = (not cfg.split_parts or kwargs.get("init_mesh") is not None
              or kwargs.get("anchors") is not None)
-    parts = []
     if not whole:
-        kept, kept_labels = fit_strokes(strokes, labels)
-        parts = stroke_parts(kept)
-    if len(parts) < 2:
+        strokes, labels = fit_strokes(strokes, labels)          # construction strokes out
+        parts = stroke_parts(strokes)
+    if whole or len(parts) == 1:
         return fit_flow_surface(strokes, labels=labels, quality=quality, **kwargs)
-    strokes, labels = kept, kept_labels
     length = np.array([arc_length(s) for s in strokes])
+    extent = np.ptp(np.vstack(strokes), axis=0).max()
     Vs, Fs, split, offset = [], [], [], 0
     for part in parts:
-        settings = _part_settings(cfg, strokes, part, length)
-        res = fit_flow_surface([strokes[i] for i in part], quality=quality,
+        mine = [strokes[i] for i in part]
+        settings = _part_settings(cfg, mine, extent, length[part].sum() / length.sum())
+        res = fit_flow_surface(mine, quality=quality,
                                labels=[labels[i] for i in part],
                                **{**kwargs, **settings})
         Vs.append(res.vertices)

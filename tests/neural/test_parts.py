@@ -55,9 +55,9 @@ def test_flat_groups_and_single_strokes_join_the_nearest_part():
 def test_a_part_keeps_the_cell_size_and_the_sample_density():
     cfg = get_config("default")
     strokes = _ball(np.zeros(3)) + _ball(np.array([3.0, 0, 0]), r=0.25)
-    length = np.array([np.linalg.norm(np.diff(s, axis=0), axis=1).sum() for s in strokes])
-    big = _part_settings(cfg, strokes, np.arange(3), length)
-    small = _part_settings(cfg, strokes, np.arange(3, 6), length)
+    extent = np.ptp(np.vstack(strokes), axis=0).max()
+    big = _part_settings(cfg, strokes[:3], extent, 0.8)
+    small = _part_settings(cfg, strokes[3:], extent, 0.2)
     # the whole spans 4.25 along x; the big ball 2 of it (128 * 2 / 4.25 -> 64 cells),
     # the small one 0.5 (15 -> the least, 32); the big ball has 0.8 of the length
     assert big["res"] == 64 and small["res"] == 32
