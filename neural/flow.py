@@ -139,7 +139,8 @@ class FlowResult(MeshResult):
     timings : dict, seconds per stage (``prefit``, ``init``, ``full``,
         ``extract``, ``total``)
     history : dict, stage -> term -> list of per-step values
-        (terms ``total, align, smooth, data, eik, curl, normal``; unweighted)
+        (terms ``total, align, smooth, data, eik, curl, normal``; without their
+        ``w_*`` weights, ``smooth`` with the spatial scale of ``smooth_near``)
     """
 
     f_grid: np.ndarray

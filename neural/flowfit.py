@@ -81,6 +81,30 @@ def _prefit_targets(init_mesh, frame: Frame, sigma, rng, n=20000):
     return P, sigma * grad, surf
 
 
+def _smoothness_scale(strokes_unit, cfg: FlowConfig):
+    """Per grid node, the smoothness weight relative to ``cfg.w_smooth``: ``(res,)*3``
+    float64 (:class:`neural.presets.FlowConfig`, ``w_smooth_near`` and ``smooth_near``),
+    or None where the weight is ``w_smooth`` everywhere.
+
+    The distance to the strokes is the grid's Euclidean distance transform from the nodes
+    nearest to the stroke samples (half a cell apart), in cells.
+    """
+    if not (cfg.smooth_near > 0 and cfg.w_smooth > 0 and cfg.w_smooth_near != cfg.w_smooth):
+        return None
+    from scipy.ndimage import distance_transform_edt
+
+    from curvenet.core.geometry import densify_polyline
+    res = cfg.res
+    pts = np.vstack([densify_polyline(s, 0.5 / res) for s in strokes_unit])
+    ijk = np.clip(np.rint(pts * res - 0.5).astype(np.int64), 0, res - 1)
+    free = np.ones((res,) * 3, bool)
+    free[tuple(ijk.T)] = False
+    d = distance_transform_edt(free)
+    near = cfg.smooth_near / 3.0
+    t = np.clip((d - near) / (cfg.smooth_near - near), 0.0, 1.0)
+    return (cfg.w_smooth_near + t * (cfg.w_smooth - cfg.w_smooth_near)) / cfg.w_smooth
+
+
 class FlowFit:
     """One flow fit: the network, the samplers, the Poisson solver and the current f.
 
@@ -122,6 +146,9 @@ class FlowFit:
         self.net = GradientSiren(cfg.width, cfg.hidden_layers, cfg.omega_0).to(
             device=dev, dtype=self.dtype)
         self.sampler = StrokeSampler(strokes_unit, dev, self.dtype)
+        scale = _smoothness_scale(strokes_unit, cfg)
+        self.smooth_scale = None if scale is None else torch.as_tensor(scale, device=dev,
+                                                                       dtype=self.dtype)
         self.solver = PoissonSolver(cfg.res, device=dev, dtype=self.dtype, boundary=cfg.boundary,
                                     lowpass=cfg.lowpass)
         self.f = None                  # the last solved f (unit-cube grid)
@@ -367,8 +394,10 @@ class FlowFit:
             vals["eik"] = eikonal_loss(g_s, cfg.sigma)
             return x_s, g_s
         if cfg.w_smooth > 0:
+            from .poisson import interpolate
             g_u, G_u, H_u = net.jet(x_u, order=2)
-            vals["smooth"] = smoothness_loss(g_u, G_u, H_u)
+            scale = None if self.smooth_scale is None else interpolate(self.smooth_scale, x_u)
+            vals["smooth"] = smoothness_loss(g_u, G_u, H_u, scale)
         else:
             g_u = net(x_u)
         vals["eik"] = eikonal_loss(torch.cat([g_u, g_s]), cfg.sigma)

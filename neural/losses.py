@@ -42,9 +42,11 @@ def alignment_loss(g, G, tangents):
     return ((cos4 - 1.0) ** 2).mean()
 
 
-def smoothness_loss(g, G, H):
-    """Eq. 5: mean over surface samples of ``||nabla_S II||_F`` (covariant TV)."""
-    return covariant_tv(g, G, H).mean()
+def smoothness_loss(g, G, H, scale=None):
+    """Eq. 5: mean over surface samples of ``||nabla_S II||_F`` (covariant TV), each
+    sample's term times ``scale`` ((N,), optional: a weight that varies in space)."""
+    tv = covariant_tv(g, G, H)
+    return (tv if scale is None else tv * scale).mean()
 
 
 def data_loss(f_strokes):

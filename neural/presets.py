@@ -26,7 +26,12 @@ Besides their budget (network, grid, samples, steps), ``draft`` and ``default`` 
 from the paper in:
 
 - smoothness weight 0.1, not 0.01: with their short budgets the paper's weight leaves
-  mid-frequency bumps;
+  mid-frequency bumps, and a rough sphere sags between its strokes. The stronger weight
+  also rounds off what the strokes outline and fills the concavities between them (the
+  space under an espresso machine's head, an iron's handle); ``smooth_near`` lowers it
+  to the paper's next to the strokes, which opens those on clean connected drawings but
+  webs close strokes together and tears thin parts of rough sketches (a hand's
+  fingers, a guitar's neck), so no preset sets it (``benchmarks/README.md``);
 - a radial geometric initialisation (``geometric_init_steps``): the plain SIREN
   initialisation starts from a rough, curl-heavy field that a short budget does not
   recover from;
@@ -124,6 +129,13 @@ class FlowConfig:
         Adam learning rate. grad_clip : float, gradient-norm clip (0 = off).
     w_align, w_smooth, w_data, w_eik, w_curl : float
         Loss weights of Eq. 13 (paper: 1, 0.01, 30, 7, 7).
+    w_smooth_near, smooth_near : float
+        Near the strokes the smoothness term is weighted ``w_smooth_near`` (the paper's
+        0.01), far from them ``w_smooth``: per surface sample, the weight rises
+        linearly from ``w_smooth_near`` at a third of ``smooth_near`` grid cells from
+        the nearest stroke to ``w_smooth`` at ``smooth_near`` cells and beyond. 0 cells
+        (every preset): ``w_smooth`` everywhere. Not in the paper (see the notes above);
+        the fairing's reach (``attach_reach``) is the distance measured with it.
     w_normal : float
         Weight of the anchors' normal term (:func:`neural.losses.normal_loss`; only
         with ``anchors``, not in the paper).
@@ -213,6 +225,8 @@ class FlowConfig:
     grad_clip: float = 10.0
     w_align: float = 1.0
     w_smooth: float = 0.01
+    w_smooth_near: float = 0.01
+    smooth_near: float = 0.0
     w_data: float = 30.0
     w_eik: float = 7.0
     w_curl: float = 7.0
@@ -316,9 +330,9 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
     for name in ("padding", "lr", "sigma", "omega_0"):
         if not getattr(cfg, name) > 0:
             raise ValueError(f"{name} must be positive, got {getattr(cfg, name)!r}")
-    for name in ("w_align", "w_smooth", "w_data", "w_eik", "w_curl", "w_normal", "grad_clip",
-                 "polish_strip", "attach", "attach_weight", "attach_band", "attach_reach",
-                 "lowpass"):
+    for name in ("w_align", "w_smooth", "w_smooth_near", "smooth_near", "w_data", "w_eik",
+                 "w_curl", "w_normal", "grad_clip", "polish_strip", "attach", "attach_weight",
+                 "attach_band", "attach_reach", "lowpass"):
         if not getattr(cfg, name) >= 0:
             raise ValueError(f"{name} must be non-negative, got {getattr(cfg, name)!r}")
     for name in ("normalize_from", "average_from"):

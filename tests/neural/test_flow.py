@@ -78,6 +78,17 @@ def test_poisson_every_runs():
     assert np.isfinite(r.history["full"]["total"]).all()
 
 
+def test_smooth_near_weights_the_smoothness_term_down_next_to_the_strokes():
+    """With ``smooth_near`` each surface sample's smoothness term is scaled by its weight
+    relative to ``w_smooth`` (at most 1, the paper's 0.01 / 0.1 next to a stroke): in the
+    first full step of the same fit the recorded term is smaller and the others equal."""
+    a = fit_flow_surface(_circles(), progress=False, w_smooth=0.1, **TINY)
+    b = fit_flow_surface(_circles(), progress=False, w_smooth=0.1, smooth_near=3.0, **TINY)
+    first = {t: (a.history["full"][t][0], b.history["full"][t][0]) for t in ("smooth", "align")}
+    assert 0.1 * first["smooth"][0] < first["smooth"][1] < first["smooth"][0]
+    assert first["align"][0] == first["align"][1]
+
+
 def test_refine_from_init_mesh():
     import trimesh
     m = trimesh.creation.icosphere(2, radius=1.0)

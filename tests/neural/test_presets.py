@@ -28,6 +28,8 @@ def test_overrides_and_presets():
                                       ({"dtype": "float16"}, "dtype"),
                                       ({"polish": 1.5}, "polish"),
                                       ({"attach_reach": -1.0}, "attach_reach"),
+                                      ({"smooth_near": -1.0}, "smooth_near"),
+                                      ({"w_smooth_near": -0.1}, "w_smooth_near"),
                                       ({"subdivide": 3}, "subdivide"),
                                       ({"subdivide": 0.5}, "subdivide")])
 def test_bad_overrides(kw, match):
@@ -38,3 +40,25 @@ def test_bad_overrides(kw, match):
 def test_bad_quality():
     with pytest.raises(ValueError, match="quality"):
         get_config("best")
+
+
+def test_the_smoothness_weight_falls_to_the_papers_next_to_the_strokes():
+    """Per grid node, the weight relative to ``w_smooth`` with ``smooth_near``: the
+    paper's 0.01 within a third of ``smooth_near`` cells of a stroke, ``w_smooth`` from
+    ``smooth_near`` cells on, linear in between; uniform (None) in every preset."""
+    import numpy as np
+
+    from curvenet.neural.flowfit import _smoothness_scale
+    t = np.linspace(0.2, 0.8, 100)
+    line = [np.c_[t, 0.5 + 0 * t, 0.5 + 0 * t]]          # along x through the middle nodes
+    for quality, near in (("draft", 3.0), ("default", 6.0)):
+        cfg = get_config(quality, smooth_near=near)
+        assert cfg.w_smooth_near == 0.01 and cfg.w_smooth == 0.1
+        scale = _smoothness_scale(line, cfg)
+        mid = cfg.res // 2
+        profile = scale[mid, mid, :] * cfg.w_smooth              # across the stroke, in z
+        d = np.abs(np.arange(cfg.res) - mid)                     # cells from the stroke
+        expect = 0.01 + np.clip((d - near / 3) / (near * 2 / 3), 0, 1) * (cfg.w_smooth - 0.01)
+        np.testing.assert_allclose(profile, expect, atol=1e-12)
+    for quality in PRESETS:
+        assert _smoothness_scale(line, get_config(quality)) is None
