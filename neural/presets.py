@@ -134,8 +134,8 @@ class FlowConfig:
         0.01), far from them ``w_smooth``: per surface sample, the weight rises
         linearly from ``w_smooth_near`` at a third of ``smooth_near`` grid cells from
         the nearest stroke to ``w_smooth`` at ``smooth_near`` cells and beyond. 0 cells
-        (every preset): ``w_smooth`` everywhere. Not in the paper (see the notes above);
-        the fairing's reach (``attach_reach``) is the distance measured with it.
+        (every preset): ``w_smooth`` everywhere. Not in the paper (see the notes above;
+        measured with 6 cells at ``default``, the fairing's reach there).
     w_normal : float
         Weight of the anchors' normal term (:func:`neural.losses.normal_loss`; only
         with ``anchors``, not in the paper).
