@@ -93,9 +93,9 @@ def _smoothness_scale(strokes_unit, cfg: FlowConfig):
         return None
     from scipy.ndimage import distance_transform_edt
 
-    from curvenet.core.geometry import densify_polyline
+    from curvenet.core.geometry import densify_polylines
     res = cfg.res
-    pts = np.vstack([densify_polyline(s, 0.5 / res) for s in strokes_unit])
+    pts = densify_polylines(strokes_unit, 0.5 / res)[0]
     ijk = np.clip(np.rint(pts * res - 0.5).astype(np.int64), 0, res - 1)
     free = np.ones((res,) * 3, bool)
     free[tuple(ijk.T)] = False
