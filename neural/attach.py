@@ -37,6 +37,29 @@ then held :data:`HELD` times harder, towards the point at ``band`` from them on 
 way to the surface (a squared hinge on the distance, by iterated reweighting): the
 surface follows a stroke only as closely as the band asks, and the noise of a rough
 stroke within it is smoothed away like the lumps.
+
+With ``normals``, a step 0 comes first: the area-weighted vertex normals of ``V`` are
+low-passed by the same filter at ``normals`` cells (renormalised), and the vertices move
+so that each face turns towards the mean of its vertices' filtered normals, by the
+vertex-position update of Sun et al. (2007; a linear-time iteration, each round moving
+every vertex towards the planes through its faces' centroids across the filtered
+normals). Filtering normals and fitting positions to them is Taubin's (2001) scheme for
+removing ripples without shrinking: a round tube or a sphere keeps its normals under
+the low-pass (they average to themselves, up to length) wherever the cutoff is shorter
+than its circumference, where the position low-pass of step 1 pulls it in by ``1 / (1 +
+k^4 / alpha)``. Its rounds take out the lumps longer than step 1's cutoff, which step 1
+alone could only reach at the cost of that shrinking. Where the surface turns within
+the filter's reach (a tube thinner than the cutoff, the two sides of a thin part, a
+fold), the unit normals average to a short vector whose direction is not the
+surface's; following it folds triangles over. So each face follows its filtered normal
+only as far as the filtered normals of its corners stay long (:data:`TRUSTED`), and a
+vertex none of whose faces is trusted stays where it is.
+
+References
+----------
+Taubin, "Linear anisotropic mesh filtering", IBM Research Report RC22213, 2001.
+Sun, Rosin, Martin, Langbein, "Fast and effective feature-preserving mesh denoising",
+IEEE TVCG 13(5), 2007 (the vertex-position update).
 """
 
 from __future__ import annotations
@@ -46,7 +69,7 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 from scipy.spatial import cKDTree
 
-__all__ = ["attach_to_strokes", "HELD", "SPREAD"]
+__all__ = ["attach_to_strokes", "normal_faired", "HELD", "NORMAL_ROUNDS", "SPREAD", "TRUSTED"]
 
 #: How much harder a stroke sample outside the band pulls than the others.
 HELD = 1000.0
@@ -54,6 +77,12 @@ HELD = 1000.0
 SPREAD = 2.0
 #: Solves after the first, each holding the samples still outside the band.
 _HOLD_ROUNDS = 2
+#: Vertex-update rounds of step 0 per cell of its cutoff: a round moves a vertex by what
+#: its one ring says, so a ripple ``normals`` cells long needs rounds in proportion.
+NORMAL_ROUNDS = 1.5
+#: Step 0 trusts a face's filtered normal not at all below the first length of its
+#: corners' filtered unit normals, in full above the second, linearly in between.
+TRUSTED = (0.7, 0.9)
 
 
 def _barycentric(tri: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -78,9 +107,60 @@ def _solve(A, rhs) -> np.ndarray:
     return np.asarray(lu.solve(rhs), np.float64)
 
 
+def _operators(V, F):
+    """The bi-Laplacian ``L^T M^-1 L`` (n, n) sparse and Voronoi areas ``m`` (n,) of ``(V, F)``."""
+    import igl
+    n = len(V)
+    L = sp.csr_matrix(igl.cotmatrix(V, F))
+    L.resize((n, n))              # libigl sizes both by the last vertex that faces use
+    m = np.zeros(n)
+    md = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal()
+    m[:len(md)] = md
+    m = np.maximum(m, 1e-12 * m.max())
+    return L.T @ sp.diags(1.0 / m) @ L, m
+
+
+def _unit_rows(x: np.ndarray) -> np.ndarray:
+    return x / np.maximum(np.linalg.norm(x, axis=1), 1e-300)[:, None]
+
+
+def normal_faired(V, F, h: float, cutoff: float) -> np.ndarray:
+    """The vertices of ``(V, F)`` moved to follow its normals low-passed at ``cutoff`` cells.
+
+    Step 0 of :func:`attach_to_strokes` (see the module notes). ``V`` (n, 3) float64,
+    ``F`` (m, 3) int64 without degenerate triangles, ``h`` the cell size; returns (n, 3)
+    float64. A vertex of no face keeps its place.
+    """
+    n = len(V)
+    bend, m = _operators(V, F)
+    alpha = (2.0 * np.pi / (cutoff * h)) ** 4 * m
+    fn = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])   # area-weighted
+    faces = np.repeat(np.arange(len(F)), 3)
+    inc = sp.csr_matrix((np.ones(3 * len(F)), (F.ravel(), faces)), shape=(n, len(F)))
+    N = _solve(bend + sp.diags(alpha), alpha[:, None] * _unit_rows(inc @ fn))
+    nf = _unit_rows(_unit_rows(N)[F].sum(axis=1))        # (m, 3) each face's target normal
+    # unit normals that the filter shortens turn within its reach (a fold, a thin part):
+    # a face follows its target in full only where its corners' stay long
+    short = np.linalg.norm(N, axis=1)[F].min(axis=1)
+    trust = np.clip((short - TRUSTED[0]) / (TRUSTED[1] - TRUSTED[0]), 0.0, 1.0)
+    inc = inc @ sp.diags(trust)
+    # Sun et al.'s update: x_i += sum_f w_f n_f n_f^T (c_f - x_i) / sum_f w_f, with c_f the
+    # mean of f's corners and w_f its trust
+    centroid = sp.csr_matrix((np.full(3 * len(F), 1.0 / 3.0), (faces, F.ravel())),
+                             shape=(len(F), n))
+    outer = (inc @ (nf[:, :, None] * nf[:, None, :]).reshape(-1, 9)).reshape(n, 3, 3)
+    deg = np.maximum(np.asarray(inc.sum(axis=1)).ravel(), 1e-12)[:, None]
+    X = np.array(V, np.float64)
+    for _ in range(int(round(NORMAL_ROUNDS * cutoff))):
+        c = centroid @ X
+        X += (inc @ (nf * (nf * c).sum(axis=1, keepdims=True))
+              - np.einsum("vij,vj->vi", outer, X)) / deg
+    return X
+
+
 def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
-                      band: float = 0.0, reach: float = 3.0,
-                      points=None) -> tuple[np.ndarray, dict]:
+                      band: float = 0.0, reach: float = 3.0, points=None,
+                      normals: float = 0.0) -> tuple[np.ndarray, dict]:
     """Fair the mesh ``(V, F)`` and pull it onto the stroke samples near it.
 
     Parameters
@@ -103,6 +183,9 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
     points : (p, 3) float64, optional
         More samples, pulled (and held) like the strokes' (a hybrid fill's anchors:
         points of the patches it meets).
+    normals : float
+        Cutoff (cells) of step 0, the normal low-pass the vertices follow before the
+        rest; 0 = no step 0.
 
     Returns
     -------
@@ -123,14 +206,12 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
     F = drop_degenerate(V, np.asarray(F, np.int64))[0]
     if not len(F):
         return V.copy(), {"samples": 0, "pulled": 0, "held": 0}
-    n = len(V)
-    L = sp.csr_matrix(igl.cotmatrix(V, F))
-    L.resize((n, n))              # libigl sizes both by the last vertex that faces use
-    m = np.zeros(n)
-    md = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal()
-    m[:len(md)] = md
-    m = np.maximum(m, 1e-12 * m.max())
-    bend = L.T @ sp.diags(1.0 / m) @ L
+    if normals > 0:                                   # step 0: follow the faired normals
+        V = normal_faired(V, F, h, normals)
+        F = drop_degenerate(V, F)[0]               # a triangle the update flattened
+        if not len(F):
+            return V, {"samples": 0, "pulled": 0, "held": 0}
+    bend, m = _operators(V, F)
     S = np.concatenate([densify_polyline(np.asarray(s, np.float64), h) for s in strokes]
                        + ([] if points is None else [np.asarray(points, np.float64)]))
     near = np.sqrt(np.maximum(igl.point_mesh_squared_distance(S, V, F)[0], 0.0)) < reach * h

@@ -77,7 +77,8 @@ Engineering choices (documented deviations / gap fills)
   small bubbles inside the solid or beside it; not for hybrid fills).
 * ``attach > 0`` (draft, default): the extracted mesh is faired and pulled onto the
   strokes near it (:mod:`neural.attach`, a stroke-constrained bi-Laplacian low-pass of
-  the vertices; the stroke samples it leaves farther than ``attach_band`` of the
+  the vertices, after one of their normals that the vertices follow where
+  ``attach_normals > 0``, default; the stroke samples it leaves farther than ``attach_band`` of the
   strokes' diagonal are held to that band), and returned so only when its stroke
   fidelity is at least the extracted mesh's. ``FlowResult.f_grid`` stays the field
   whose zero set was extracted. With ``anchors`` (a hybrid fill) the anchor points
@@ -341,6 +342,7 @@ def _attached(V, F, strokes, h_world, cfg: FlowConfig, before: float | None = No
     band = 0.0 if anchors is not None else cfg.attach_band * bbox_diagonal(list(strokes))
     X, rep = attach_to_strokes(V, F, strokes, h_world, cutoff=cfg.attach,
                                weight=cfg.attach_weight, band=band, reach=cfg.attach_reach,
+                               normals=cfg.attach_normals,
                                points=anchors)
     if before is None:
         before = _fidelity(V, F, strokes)

@@ -59,7 +59,10 @@ of the box's side (``attach_reach``: 6 cells, 3) are held to within half the
 stroke-fidelity tolerance (``attach_band``). A short cutoff with the
 pull alone (6 cells) leaves the surfaces several times rougher by the local-quadric
 measure and further from the classical surfaces; a long cutoff with the pull alone lets
-the surface sag off its strokes (figures: ``benchmarks/README.md``).
+the surface sag off its strokes; a longer cutoff of the positions thins tubes between
+their strokes. So the lumps up to twice the cutoff long are first taken out of the
+normals, which a tube keeps (``attach_normals``: 40 cells at ``default``), and the
+vertices follow them (figures: ``benchmarks/README.md``).
 
 Both fit the separately drawn bodies of a connected drawing one at a time
 (``split_parts``, :mod:`neural.parts`): one field for the whole joins close bodies with
@@ -195,6 +198,11 @@ class FlowConfig:
         In that fairing, the stroke samples farther than this many grid cells from the
         extracted surface are left out (not pulled). The same share of the padded box
         in ``draft`` (3 of 64 cells) and ``default`` (6 of 128), as the cutoff is.
+    attach_normals : float
+        In that fairing, the vertex normals are first low-passed at this many grid
+        cells and the vertices moved to follow them (:func:`neural.attach.normal_faired`):
+        ripples up to this long go without the shrinking of a position low-pass; 0 =
+        not done. Not in the paper.
     subdivide : int
         Rounds (at most :data:`MAX_SUBDIVIDE`) of curved 1-to-4 subdivision of the final
         mesh (:func:`curvenet.core.geometry.subdivide_curved`): the new vertices on the
@@ -245,6 +253,7 @@ class FlowConfig:
     attach_weight: float = 100.0
     attach_band: float = 0.0
     attach_reach: float = 3.0
+    attach_normals: float = 0.0
     subdivide: int = 0
     split_parts: int = 0
 
@@ -260,8 +269,8 @@ PRESETS: dict[str, FlowConfig] = {
                         split_parts=1),
     "default": FlowConfig(steps=140, w_smooth=0.1, polish=4, polish_rounds=4,
                           polish_strip=1.0, average_from=0.6, attach=20.0,
-                          attach_band=0.005, attach_reach=6.0, subdivide=1,
-                          split_parts=1),
+                          attach_band=0.005, attach_reach=6.0, attach_normals=40.0,
+                          subdivide=1, split_parts=1),
     "paper": FlowConfig(res=256, width=256, hidden_layers=4, n_stroke=10000, n_surface=15000,
                         n_volume=15000, init_steps=200, steps=800, lr=5e-5,
                         geometric_init_steps=0),
@@ -332,7 +341,7 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
             raise ValueError(f"{name} must be positive, got {getattr(cfg, name)!r}")
     for name in ("w_align", "w_smooth", "w_smooth_near", "smooth_near", "w_data", "w_eik",
                  "w_curl", "w_normal", "grad_clip", "polish_strip", "attach", "attach_weight",
-                 "attach_band", "attach_reach", "lowpass"):
+                 "attach_band", "attach_reach", "attach_normals", "lowpass"):
         if not getattr(cfg, name) >= 0:
             raise ValueError(f"{name} must be non-negative, got {getattr(cfg, name)!r}")
     for name in ("normalize_from", "average_from"):

@@ -28,6 +28,7 @@ def test_overrides_and_presets():
                                       ({"dtype": "float16"}, "dtype"),
                                       ({"polish": 1.5}, "polish"),
                                       ({"attach_reach": -1.0}, "attach_reach"),
+                                      ({"attach_normals": -1.0}, "attach_normals"),
                                       ({"smooth_near": -1.0}, "smooth_near"),
                                       ({"w_smooth_near": -0.1}, "w_smooth_near"),
                                       ({"subdivide": 3}, "subdivide"),
