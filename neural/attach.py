@@ -69,6 +69,9 @@ import scipy.sparse as sp
 from scipy.sparse.linalg import splu
 from scipy.spatial import cKDTree
 
+from curvenet.core.geometry import face_normals_areas
+from curvenet.core.tolerances import DIVISION_GUARD
+
 __all__ = ["attach_to_strokes", "normal_faired", "HELD", "NORMAL_ROUNDS", "SPREAD", "TRUSTED"]
 
 #: How much harder a stroke sample outside the band pulls than the others.
@@ -121,7 +124,7 @@ def _operators(V, F):
 
 
 def _unit_rows(x: np.ndarray) -> np.ndarray:
-    return x / np.maximum(np.linalg.norm(x, axis=1), 1e-300)[:, None]
+    return x / np.maximum(np.linalg.norm(x, axis=1), DIVISION_GUARD)[:, None]
 
 
 def normal_faired(V, F, h: float, cutoff: float) -> np.ndarray:
@@ -134,10 +137,11 @@ def normal_faired(V, F, h: float, cutoff: float) -> np.ndarray:
     n = len(V)
     bend, m = _operators(V, F)
     alpha = (2.0 * np.pi / (cutoff * h)) ** 4 * m
-    fn = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])   # area-weighted
-    faces = np.repeat(np.arange(len(F)), 3)
-    inc = sp.csr_matrix((np.ones(3 * len(F)), (F.ravel(), faces)), shape=(n, len(F)))
-    N = _solve(bend + sp.diags(alpha), alpha[:, None] * _unit_rows(inc @ fn))
+    fn, area = face_normals_areas(V, F)
+    inc = sp.csr_matrix((np.ones(3 * len(F)), (F.ravel(), np.repeat(np.arange(len(F)), 3))),
+                        shape=(n, len(F)))                       # vertex-face incidence
+    centroid = inc.T / 3.0                                       # (m, n): corners' mean
+    N = _solve(bend + sp.diags(alpha), alpha[:, None] * _unit_rows(inc @ (fn * area[:, None])))
     nf = _unit_rows(_unit_rows(N)[F].sum(axis=1))        # (m, 3) each face's target normal
     # unit normals that the filter shortens turn within its reach (a fold, a thin part):
     # a face follows its target in full only where its corners' stay long
@@ -146,8 +150,6 @@ def normal_faired(V, F, h: float, cutoff: float) -> np.ndarray:
     inc = inc @ sp.diags(trust)
     # Sun et al.'s update: x_i += sum_f w_f n_f n_f^T (c_f - x_i) / sum_f w_f, with c_f the
     # mean of f's corners and w_f its trust
-    centroid = sp.csr_matrix((np.full(3 * len(F), 1.0 / 3.0), (faces, F.ravel())),
-                             shape=(len(F), n))
     outer = (inc @ (nf[:, :, None] * nf[:, None, :]).reshape(-1, 9)).reshape(n, 3, 3)
     deg = np.maximum(np.asarray(inc.sum(axis=1)).ravel(), 1e-12)[:, None]
     X = np.array(V, np.float64)
@@ -199,7 +201,7 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
     import igl
 
     from curvenet.core.distance import drop_degenerate
-    from curvenet.core.geometry import densify_polyline
+    from curvenet.core.geometry import densify_polylines
     V = np.asarray(V, np.float64)
     # marching cubes leaves a few zero-area triangles, whose cotangents are not finite:
     # the energy is taken over the others (a vertex of none keeps its place)
@@ -212,7 +214,7 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
         if not len(F):
             return V, {"samples": 0, "pulled": 0, "held": 0}
     bend, m = _operators(V, F)
-    S = np.concatenate([densify_polyline(np.asarray(s, np.float64), h) for s in strokes]
+    S = np.concatenate(([densify_polylines(strokes, h)[0]] if len(strokes) else [])
                        + ([] if points is None else [np.asarray(points, np.float64)]))
     near = np.sqrt(np.maximum(igl.point_mesh_squared_distance(S, V, F)[0], 0.0)) < reach * h
     S = S[near]

@@ -77,8 +77,8 @@ Engineering choices (documented deviations / gap fills)
   small bubbles inside the solid or beside it; not for hybrid fills).
 * ``attach > 0`` (draft, default): the extracted mesh is faired and pulled onto the
   strokes near it (:mod:`neural.attach`, a stroke-constrained bi-Laplacian low-pass of
-  the vertices, after one of their normals that the vertices follow where
-  ``attach_normals > 0``, default; the stroke samples it leaves farther than ``attach_band`` of the
+  the vertices, at ``default`` after a low-pass of their normals that the vertices
+  follow, ``attach_normals``; the stroke samples it leaves farther than ``attach_band`` of the
   strokes' diagonal are held to that band), and returned so only when its stroke
   fidelity is at least the extracted mesh's. ``FlowResult.f_grid`` stays the field
   whose zero set was extracted. With ``anchors`` (a hybrid fill) the anchor points
