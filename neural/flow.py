@@ -40,7 +40,7 @@ Engineering choices (documented deviations / gap fills)
   (:class:`neural.presets.FlowConfig` says when it helps).
 * The padded box is a cube (longest side + 20 % on every side) so the grid is
   isotropic.
-* Ctrl-C (KeyboardInterrupt) stops the optimisation
+* Ctrl-C (KeyboardInterrupt), or ``stop`` set from another thread, stops the optimisation
   (:func:`neural.training.train`); the surface of the last completed Poisson
   solve whose f is finite ("the best so far") is returned with
   ``report["interrupted"] = True``.
@@ -182,7 +182,8 @@ def fit_strokes(strokes, labels):
 
 def fit_flow_surface(strokes, *, labels=None, quality: str = "draft", device="cpu", seed: int = 0,
                      init_mesh=None, anchors=None, progress: bool = True,
-                     cut_boundary: bool = True, **overrides) -> FlowResult:
+                     cut_boundary: bool = True, desc: str = "neural", stop=None,
+                     **overrides) -> FlowResult:
     """Fit a flow-aligned implicit surface to 3D strokes (Zhang et al. 2025).
 
     Parameters
@@ -214,6 +215,11 @@ def fit_flow_surface(strokes, *, labels=None, quality: str = "draft", device="cp
         Show a tqdm bar with the loss terms.
     cut_boundary : bool
         Apply the boundary cut.
+    desc : str
+        Label of the progress bar.
+    stop : threading.Event, optional
+        Set from another thread, the optimisation stops as at Ctrl-C (see the module
+        notes).
     **overrides
         Any :class:`neural.presets.FlowConfig` field (``res=96``, ``steps=50``,
         ``w_smooth=0``...).
@@ -240,7 +246,7 @@ def fit_flow_surface(strokes, *, labels=None, quality: str = "draft", device="cp
     strokes, labels = fit_strokes(strokes, labels)
     dev = torch_device(device)
     return _fit(strokes, labels, cfg, dev, int(seed), init_mesh, progress, cut_boundary, quality,
-                anchors=_check_anchors(anchors))
+                anchors=_check_anchors(anchors), desc=desc, stop=stop)
 
 
 def _check_anchors(anchors):
@@ -261,15 +267,16 @@ def _check_anchors(anchors):
 
 
 def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_boundary, quality,
-         anchors=None):
+         anchors=None, desc="neural", stop=None):
     t_start = time.perf_counter()
     fit = FlowFit(strokes, cfg, dev, seed, init_mesh, anchors)
     stages = fit.stages()
     interrupted = False
     if init_mesh is None and cfg.geometric_init_steps > 0:
-        interrupted = train(fit.net.parameters(), [fit.geometric_stage()], lr=1e-3).interrupted
+        interrupted = train(fit.net.parameters(), [fit.geometric_stage()], lr=1e-3,
+                            stop=stop).interrupted
     run = train(fit.net.parameters(), [] if interrupted else stages, lr=cfg.lr,
-                grad_clip=cfg.grad_clip, progress=progress, desc="neural")
+                grad_clip=cfg.grad_clip, progress=progress, desc=desc, stop=stop)
     interrupted = interrupted or run.interrupted
     timings = {s.name: run.timings.get(s.name, 0.0) for s in stages}
     steps_done = {s.name: run.steps.get(s.name, 0) for s in stages}

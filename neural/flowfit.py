@@ -18,7 +18,7 @@ from curvenet.core.tolerances import COINCIDENT_REL, NORM_EPS
 from .frame import Frame
 from .presets import FlowConfig
 from .sampling import StrokeSampler, sample_surface_cells
-from .training import Stage, Step, seeded
+from .training import GLOBAL_STREAM, Stage, Step, seeded
 
 __all__ = ["FlowFit"]
 
@@ -142,9 +142,10 @@ class FlowFit:
         self.frame = Frame.from_points(np.vstack(strokes + ([] if anchors is None
                                                             else [anchors[0]])), cfg.padding)
         strokes_unit = [self.frame.to_unit(s) for s in strokes]
-        self.gen, self.rng = seeded(seed, dev)
-        self.net = GradientSiren(cfg.width, cfg.hidden_layers, cfg.omega_0).to(
-            device=dev, dtype=self.dtype)
+        with GLOBAL_STREAM:                 # the weights come from torch's global stream
+            self.gen, self.rng = seeded(seed, dev)
+            self.net = GradientSiren(cfg.width, cfg.hidden_layers, cfg.omega_0).to(
+                device=dev, dtype=self.dtype)
         self.sampler = StrokeSampler(strokes_unit, dev, self.dtype)
         scale = _smoothness_scale(strokes_unit, cfg)
         self.smooth_scale = None if scale is None else torch.as_tensor(scale, device=dev,

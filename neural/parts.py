@@ -1,4 +1,4 @@
-"""Separately drawn parts of a sketch, fitted one at a time.
+"""Separately drawn parts of a sketch, each fitted on its own.
 
 One implicit field for the whole sketch joins parts that are drawn apart: the
 Poisson integration of g spans the gap between two close bodies with a web or a
@@ -29,6 +29,10 @@ volume ones by its cube; at least :data:`PART_MIN_SAMPLES` each), so every
 setting given in cells means what it means for the whole sketch. The grids and the
 samples of the parts together cost about what the whole's do, but every fit also pays
 the per-step cost of the network's backward, which does not shrink with the part.
+That cost is mostly Python's (the dispatch of small tensor operations) on a small
+part, so :data:`PART_WORKERS` parts are fitted at once, in threads: a small part's
+steps run beside the large part's tensor operations. Every fit draws from its own
+seeded streams, so the meshes are those of the parts fitted one after the other.
 
 References
 ----------
@@ -46,7 +50,7 @@ from curvenet.core.fidelity import FIDELITY_TOL_REL
 from curvenet.core.geometry import arc_length, bbox_diagonal, densify_polylines
 
 __all__ = ["stroke_parts", "fit_parts", "CONNECTED_ENDS", "PART_MIN_STROKES",
-           "PART_MIN_THICKNESS", "PART_MIN_RES", "PART_MIN_SAMPLES"]
+           "PART_MIN_THICKNESS", "PART_MIN_RES", "PART_MIN_SAMPLES", "PART_WORKERS"]
 
 #: Share of stroke ends that must touch another stroke for a drawing to be split.
 CONNECTED_ENDS = 0.9
@@ -58,6 +62,10 @@ PART_MIN_THICKNESS = 0.1
 PART_MIN_RES = 32
 #: Fewest Monte-Carlo samples of each kind per step in a part's fit.
 PART_MIN_SAMPLES = 256
+#: Parts fitted at once, each in a thread. A small part's fit is mostly the Python side
+#: of its steps, which the other fit's tensor operations run beside; more threads
+#: would only wait for each other.
+PART_WORKERS = 2
 
 
 def _groups(strokes, tol):
@@ -185,20 +193,65 @@ def fit_parts(strokes, labels=None, *, quality: str = "draft", **kwargs):
         return fit_flow_surface(strokes, labels=labels, quality=quality, **kwargs)
     length = np.array([arc_length(s) for s in strokes])
     extent = np.ptp(np.vstack(strokes), axis=0).max()
+    settings = [_part_settings(cfg, [strokes[i] for i in part], extent,
+                               length[part].sum() / length.sum()) for part in parts]
+    results = _fit_side_by_side(parts, settings, strokes, labels, quality, kwargs)
     Vs, Fs, split, offset = [], [], [], 0
-    for part in parts:
-        mine = [strokes[i] for i in part]
-        settings = _part_settings(cfg, mine, extent, length[part].sum() / length.sum())
-        res = fit_flow_surface(mine, quality=quality,
-                               labels=[labels[i] for i in part],
-                               **{**kwargs, **settings})
+    for part, setting, res in zip(parts, settings, results):
+        if res is None:                         # not started: the others were stopped
+            continue
         Vs.append(res.vertices)
         Fs.append(res.faces + offset)
         offset += len(res.vertices)
-        split.append({"strokes": part.tolist(), "settings": settings, "report": res.report})
-        if res.report["interrupted"]:
-            break
+        split.append({"strokes": part.tolist(), "settings": setting, "report": res.report})
     report = {**split[0]["report"], "split": split, "n_vertices": offset,
               "n_faces": sum(len(f) for f in Fs),
-              "interrupted": any(s["report"]["interrupted"] for s in split)}
+              "interrupted": len(split) < len(parts)
+              or any(s["report"]["interrupted"] for s in split)}
     return MeshResult(np.vstack(Vs), np.vstack(Fs), report)
+
+
+def _fit_side_by_side(parts, settings, strokes, labels, quality, kwargs) -> list:
+    """Each part's :func:`neural.flow.fit_flow_surface`, :data:`PART_WORKERS` at a time.
+
+    Returns one result per part, in order (None for a part not started before a Ctrl-C).
+    A Ctrl-C stops every running fit at its next step (their best so far is returned,
+    ``interrupted``), and the parts not yet started are not fitted; an error in one part
+    stops the others and is raised. Each fit draws from its own seeded streams
+    (:data:`neural.training.GLOBAL_STREAM`), so the meshes are those of the parts fitted
+    one after the other.
+    """
+    import threading
+    from concurrent.futures import FIRST_EXCEPTION, ThreadPoolExecutor, wait
+
+    from .flow import fit_flow_surface
+    stop = threading.Event()
+
+    def fit(k):
+        if stop.is_set():
+            return None
+        return fit_flow_surface([strokes[i] for i in parts[k]], quality=quality,
+                                labels=[labels[i] for i in parts[k]],
+                                desc=f"neural part {k + 1}/{len(parts)}", stop=stop,
+                                **{**kwargs, **settings[k]})
+
+    with ThreadPoolExecutor(min(PART_WORKERS, len(parts))) as pool:
+        futures = []
+        try:
+            for k in range(len(parts)):                       # largest first
+                futures.append(pool.submit(fit, k))
+            pending = futures
+            # in short waits: a Ctrl-C's KeyboardInterrupt is raised when this thread
+            # next runs, and a blocking wait might not be woken by the signal
+            while pending and not any(f.exception() for f in futures if f.done()):
+                pending = wait(pending, timeout=0.1, return_when=FIRST_EXCEPTION).not_done
+        except KeyboardInterrupt:
+            stop.set()
+            wait(futures)
+            return ([None if f.exception() else f.result() for f in futures]
+                    + [None] * (len(parts) - len(futures)))
+        failed = [f.exception() for f in futures if f.done() and f.exception()]
+        if failed:
+            stop.set()                         # the others stop at their next step
+            raise failed[0]
+        return [f.result() for f in futures]

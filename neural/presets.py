@@ -64,9 +64,9 @@ their strokes. So the lumps up to twice the cutoff long are first taken out of t
 normals, which a tube keeps (``attach_normals``: 40 cells at ``default``), and the
 vertices follow them (figures: ``benchmarks/README.md``).
 
-Both fit the separately drawn bodies of a connected drawing one at a time
-(``split_parts``, :mod:`neural.parts`): one field for the whole joins close bodies with
-a web that no stroke holds.
+Both fit the separately drawn bodies of a connected drawing each on its own, two at
+once (``split_parts``, :mod:`neural.parts`): one field for the whole joins close bodies
+with a web that no stroke holds.
 
 Crease presets: ``draft`` for a CPU, ``default`` a 4 x 256 MLP trained 3,000 steps,
 ``paper`` the network size and the 15,000 steps of the paper's 3D examples (Sec. 5),

@@ -6,8 +6,8 @@ seeds its random streams with :func:`seeded`, checks its device with
 step functions build one loss each. The loop owns what is common: the Adam optimiser
 (shared by all stages of one call), the optional cosine learning-rate decay and
 gradient clipping, the progress bar, per-stage step counts and timings, the
-best-so-far state, and Ctrl-C (``KeyboardInterrupt``), which ends the loop early and
-is reported, not raised.
+best-so-far state, and Ctrl-C (``KeyboardInterrupt``, or a ``stop`` event set from
+another thread), which ends the loop early and is reported, not raised.
 
 The optimiser sees the same operations in the same order as a hand-written loop
 (zero the gradients, build the loss, backward, clip, step, schedule), so seeded CPU
@@ -17,13 +17,14 @@ runs are reproducible bit for bit.
 from __future__ import annotations
 
 import math
+import threading
 import time
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
 import numpy as np
 
-__all__ = ["Step", "Stage", "Training", "train", "seeded", "torch_device"]
+__all__ = ["Step", "Stage", "Training", "train", "seeded", "torch_device", "GLOBAL_STREAM"]
 
 
 @dataclass
@@ -91,6 +92,12 @@ class Training:
     log: dict
 
 
+#: Held while a fit seeds torch's global stream and draws its network's first weights from
+#: it (:func:`seeded`, then the network's constructor): fits run side by side in threads
+#: (:func:`neural.parts.fit_parts`) then draw the weights each would draw alone.
+GLOBAL_STREAM = threading.Lock()
+
+
 def seeded(seed: int, device="cpu"):
     """Seed torch's global stream and return ``(generator, rng)`` for ``seed``.
 
@@ -142,7 +149,8 @@ def _is_finite(state) -> bool:
 
 def train(params, stages, *, lr: float, grad_clip: float = 0.0, schedule: str = "constant",
           lr_min: float = 0.0, progress: bool = False, desc: str = "fit",
-          keep: Callable[[Any], bool] = _is_finite) -> Training:
+          keep: Callable[[Any], bool] = _is_finite,
+          stop: threading.Event | None = None) -> Training:
     """Minimise the step functions' losses with one Adam optimiser, stage after stage.
 
     Parameters
@@ -167,6 +175,9 @@ def train(params, stages, *, lr: float, grad_clip: float = 0.0, schedule: str = 
         Label of the bar.
     keep : callable
         Predicate on offered states (default: a tensor state must be finite everywhere).
+    stop : threading.Event, optional
+        Set from another thread, the run stops before its next step as at Ctrl-C
+        (``interrupted``); a fit in a worker thread gets no KeyboardInterrupt.
 
     Returns
     -------
@@ -199,6 +210,9 @@ def train(params, stages, *, lr: float, grad_clip: float = 0.0, schedule: str = 
             if stage.start is not None:
                 _offer(out, stage.start(), keep)
             for k in range(stage.steps):
+                if stop is not None and stop.is_set():
+                    out.interrupted = True
+                    return out
                 opt.zero_grad()
                 step = stage.step(k)
                 step.loss.backward()

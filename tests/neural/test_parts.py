@@ -81,6 +81,67 @@ def test_two_close_balls_fit_as_two_bodies_without_a_web():
     assert res.report["n_faces"] == len(res.faces)
 
 
+def test_parts_fitted_side_by_side_are_the_parts_fitted_one_after_the_other(monkeypatch):
+    import curvenet.neural.parts as parts
+    strokes = _ball(np.zeros(3)) + _ball(np.array([2.2, 0, 0]), r=0.5)
+    meshes = []
+    for workers in (1, 2):
+        monkeypatch.setattr(parts, "PART_WORKERS", workers)
+        res = fit_parts(strokes, quality="draft", progress=False, init_steps=10, steps=10)
+        meshes.append((res.vertices, res.faces))
+    assert len(meshes[0][0]) > 1000
+    assert np.array_equal(meshes[0][0], meshes[1][0]) and np.array_equal(meshes[0][1], meshes[1][1])
+
+
+def _three_balls():
+    return sum((_ball(np.array([2.2 * k, 0, 0])) for k in range(3)), [])
+
+
+def test_ctrl_c_stops_the_running_parts_and_skips_the_rest(monkeypatch):
+    import _thread
+    import time
+
+    import curvenet.neural.flow as flow
+    import curvenet.neural.parts as parts
+    from curvenet.core.result import MeshResult
+    monkeypatch.setattr(parts, "PART_WORKERS", 2)
+    started = []
+
+    def fake(strokes, labels=None, *, stop, **kw):
+        started.append(kw["desc"])
+        if len(started) == 2:           # both workers busy: the user presses Ctrl-C
+            time.sleep(0.5)             # (once every part is queued)
+            _thread.interrupt_main()
+        assert stop.wait(10.0)          # each running fit stops at its next step
+        return MeshResult(np.vstack(strokes)[:3], [[0, 1, 2]], {"interrupted": True})
+
+    monkeypatch.setattr(flow, "fit_flow_surface", fake)
+    res = fit_parts(_three_balls(), quality="draft")
+    assert sorted(started) == ["neural part 1/3", "neural part 2/3"]
+    assert [s["strokes"] for s in res.report["split"]] == [[0, 1, 2], [3, 4, 5]]
+    assert res.report["interrupted"] and len(res.faces) == 2
+
+
+def test_an_error_in_one_part_stops_the_others_and_is_raised(monkeypatch):
+    import curvenet.neural.flow as flow
+    import curvenet.neural.parts as parts
+    monkeypatch.setattr(parts, "PART_WORKERS", 2)
+    stopped = []
+
+    def fake(strokes, labels=None, *, stop, desc, **kw):
+        if desc == "neural part 2/3":
+            raise ValueError("bad part")
+        stopped.append(stop.wait(10.0))
+        return None
+
+    monkeypatch.setattr(flow, "fit_flow_surface", fake)
+    with pytest.raises(ValueError, match="bad part"):
+        fit_parts(_three_balls(), quality="draft")
+    # part 1 was stopped; part 3 was not started, or stopped too if it took the freed worker
+    # before the error reached the caller
+    assert stopped and all(stopped)
+
+
 def test_split_parts_off_or_a_refinement_fits_the_whole(monkeypatch):
     import curvenet.neural.flow as flow
     calls = []

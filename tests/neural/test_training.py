@@ -59,6 +59,22 @@ def test_keyboard_interrupt_returns_best_so_far():
     assert torch.equal(out.best, _hand_written_adam(torch.zeros(3), 8, 0.05)[-1])
 
 
+def test_a_stop_event_set_elsewhere_ends_the_run_like_ctrl_c():
+    import threading
+    stop = threading.Event()
+    x = torch.nn.Parameter(torch.zeros(3))
+    quadratic = _quadratic(x)
+
+    def step(k):                        # another thread would set it; here step 3 does
+        if k == 3:
+            stop.set()
+        return quadratic(k)
+
+    out = train([x], [Stage("a", 10, step), Stage("b", 10, quadratic)], lr=0.05, stop=stop)
+    assert out.interrupted and out.steps == {"a": 4, "b": 0}
+    assert torch.equal(out.best, _hand_written_adam(torch.zeros(3), 3, 0.05)[-1])
+
+
 def test_non_finite_states_are_not_kept():
     x = torch.nn.Parameter(torch.zeros(3))
     out = train([x], [Stage("fit", 10, _quadratic(x, nan_from=6))], lr=0.05)
