@@ -216,7 +216,8 @@ def _fit_side_by_side(parts, settings, strokes, labels, quality, kwargs) -> list
 
     Returns one result per part, in order (None for a part not started before a Ctrl-C).
     A Ctrl-C stops every running fit at its next step (their best so far is returned,
-    ``interrupted``), and the parts not yet started are not fitted; an error in one part
+    ``interrupted``); the parts not yet started are not fitted, except the first (the
+    largest), which gives at least the surface of its strokes alone. An error in one part
     stops the others and is raised. Each fit draws from its own seeded streams
     (:data:`neural.training.GLOBAL_STREAM`), so the meshes are those of the parts fitted
     one after the other.
@@ -228,7 +229,7 @@ def _fit_side_by_side(parts, settings, strokes, labels, quality, kwargs) -> list
     stop = threading.Event()
 
     def fit(k):
-        if stop.is_set():
+        if stop.is_set() and k:
             return None
         return fit_flow_surface([strokes[i] for i in parts[k]], quality=quality,
                                 labels=[labels[i] for i in parts[k]],
@@ -247,6 +248,8 @@ def _fit_side_by_side(parts, settings, strokes, labels, quality, kwargs) -> list
                 pending = wait(pending, timeout=0.1, return_when=FIRST_EXCEPTION).not_done
         except KeyboardInterrupt:
             stop.set()
+            if not futures:                    # the largest part still gives a surface
+                futures.append(pool.submit(fit, 0))
             wait(futures)
             return ([None if f.exception() else f.result() for f in futures]
                     + [None] * (len(parts) - len(futures)))

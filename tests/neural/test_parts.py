@@ -122,6 +122,31 @@ def test_ctrl_c_stops_the_running_parts_and_skips_the_rest(monkeypatch):
     assert res.report["interrupted"] and len(res.faces) == 2
 
 
+def test_ctrl_c_before_any_part_starts_still_gives_the_largest_part(monkeypatch):
+    import concurrent.futures
+
+    import curvenet.neural.flow as flow
+    from curvenet.core.result import MeshResult
+    submit, calls = concurrent.futures.ThreadPoolExecutor.submit, []
+
+    def pressed_first(pool, fn, *args):
+        calls.append(args)
+        if len(calls) == 1:
+            raise KeyboardInterrupt
+        return submit(pool, fn, *args)
+
+    def fake(strokes, labels=None, *, stop, **kw):
+        assert stop.is_set()            # the fit stops at once and gives its best so far
+        return MeshResult(np.vstack(strokes)[:3], [[0, 1, 2]], {"interrupted": True})
+
+    monkeypatch.setattr(concurrent.futures.ThreadPoolExecutor, "submit", pressed_first)
+    monkeypatch.setattr(flow, "fit_flow_surface", fake)
+    res = fit_parts(_three_balls(), quality="draft")
+    assert calls == [(0,), (0,)]
+    assert [s["strokes"] for s in res.report["split"]] == [[0, 1, 2]]
+    assert res.report["interrupted"]
+
+
 def test_an_error_in_one_part_stops_the_others_and_is_raised(monkeypatch):
     import curvenet.neural.flow as flow
     import curvenet.neural.parts as parts
