@@ -108,8 +108,8 @@ def fill_order(F, n: int) -> np.ndarray:
 
     METIS's nested dissection (pymetis) of the graph of vertices within two edges of
     each other, the pattern of ``L^T M^-1 L`` and of every matrix the fairing solves:
-    computed once, it serves all of one fairing's factorisations, which then take about
-    half the time of SuperLU's own minimum-degree ordering. A nested dissection of the
+    computed once, it serves all of one fairing's factorisations, each of which then
+    leaves less fill and skips SuperLU's own minimum-degree ordering. A nested dissection of the
     one-ring graph alone is no order for them (its separators leave the two-ring
     neighbours on either side coupled: many times the fill).
     """
