@@ -109,9 +109,9 @@ def fill_order(F, n: int) -> np.ndarray:
     METIS's nested dissection (pymetis) of the graph of vertices within two edges of
     each other, the pattern of ``L^T M^-1 L`` and of every matrix the fairing solves:
     computed once, it serves all of one fairing's factorisations, each of which then
-    leaves less fill and skips SuperLU's own minimum-degree ordering. A nested dissection of the
-    one-ring graph alone is no order for them (its separators leave the two-ring
-    neighbours on either side coupled: many times the fill).
+    leaves less fill and skips SuperLU's own minimum-degree ordering. A nested
+    dissection of the one-ring graph alone is no order for them (its separators leave
+    the two-ring neighbours on either side coupled: many times the fill).
     """
     import pymetis
     e = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
@@ -126,14 +126,19 @@ def fill_order(F, n: int) -> np.ndarray:
     return np.asarray(pymetis.nested_dissection(adjacency=adj)[0], np.int64)
 
 
-def _solve(A, rhs, order: np.ndarray) -> np.ndarray:
-    """``A^-1 rhs`` for a sparse symmetric positive definite ``A`` in the fill ``order``."""
+def _factor(A, order: np.ndarray):
+    """SuperLU's factors of ``A`` (n, n) sparse symmetric positive definite, its rows and
+    columns taken in the fill ``order`` (n,)."""
     A = sp.csr_matrix(A)
     # the order applied to both sides and no pivoting: Cholesky's fill
-    lu = splu(A[order][:, order].tocsc(), permc_spec="NATURAL", diag_pivot_thresh=0.0,
-              options={"SymmetricMode": True})
+    return splu(A[order][:, order].tocsc(), permc_spec="NATURAL", diag_pivot_thresh=0.0,
+                options={"SymmetricMode": True})
+
+
+def _solve(A, rhs, order: np.ndarray) -> np.ndarray:
+    """``A^-1 rhs`` for a sparse symmetric positive definite ``A`` in the fill ``order``."""
     x = np.empty(np.shape(rhs), np.float64)
-    x[order] = lu.solve(np.asarray(rhs, np.float64)[order])
+    x[order] = _factor(A, order).solve(np.asarray(rhs, np.float64)[order])
     return x
 
 

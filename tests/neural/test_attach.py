@@ -308,8 +308,6 @@ def test_the_fill_order_solves_as_a_plain_factorisation_with_less_fill():
     import scipy.sparse as sp
     from scipy.sparse.linalg import splu
 
-    import trimesh
-
     s = trimesh.creation.icosphere(subdivisions=5)
     V = np.vstack([s.vertices, [[3.0, 0.0, 0.0]]])             # the last vertex: no face
     F = np.asarray(s.faces, np.int64)
@@ -322,6 +320,4 @@ def test_the_fill_order_solves_as_a_plain_factorisation_with_less_fill():
                options={"SymmetricMode": True})
     x = A._solve(K, rhs, order)
     np.testing.assert_allclose(x, ref.solve(rhs), rtol=0, atol=1e-9 * np.abs(x).max())
-    ours = splu(sp.csr_matrix(K)[order][:, order].tocsc(), permc_spec="NATURAL",
-                diag_pivot_thresh=0.0, options={"SymmetricMode": True})
-    assert ours.L.nnz < 0.9 * ref.L.nnz
+    assert A._factor(K, order).L.nnz < 0.9 * ref.L.nnz
