@@ -85,6 +85,10 @@ Engineering choices (documented deviations / gap fills)
   pull like stroke samples, so the faired fill still meets the patches, and nothing
   is held to the band: a fill's strokes are the loose ones no patch closes, and
   holding each of them drags thin sheets of the fill onto the strays (spikes).
+* ``handles`` (default): before the extraction, the small holes and thin strands that
+  the Monte-Carlo noise of f leaves in its zero set (each a handle of the surface, a
+  pit or a tear once faired) are plugged and cut on the grid, the rest of the zero
+  set unmoved (:func:`neural.topology.remove_small_handles`).
 * ``subdivide`` (draft, default): the final mesh is subdivided once, its new vertices
   on the curved point-normal triangles of the old ones
   (:func:`curvenet.core.geometry.subdivide_curved`): the facets of a mesh extracted
@@ -283,7 +287,7 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
 
     t0 = time.perf_counter()
     f_final = run.best if run.best is not None else fit.solve_strokes_only()
-    mesh = _extract(f_final, fit.frame, strokes, labels, cut_boundary)
+    mesh = _extract(f_final, fit.frame, strokes, labels, cut_boundary, cfg.handles)
     polish = None
     if cfg.polish > 0 and not interrupted:
         mesh, polish = _polished(fit, f_final, mesh, strokes, labels, cut_boundary)
@@ -329,7 +333,8 @@ def _polished(fit: FlowFit, f, mesh, strokes, labels, cut_boundary):
 
     Returns ``(mesh, {"fidelity": [last step's, polished], "kept": bool})``.
     """
-    polished = _extract(fit.polish(f), fit.frame, strokes, labels, cut_boundary)
+    polished = _extract(fit.polish(f), fit.frame, strokes, labels, cut_boundary,
+                        fit.cfg.handles)
     fidelity = [_fidelity(m[0], m[1], strokes) for m in (mesh, polished)]
     kept = fidelity[1] >= fidelity[0]
     return (polished if kept else mesh), {"fidelity": fidelity, "kept": kept}
@@ -368,8 +373,10 @@ def _fidelity(V, F, strokes) -> float:
         return 0.0
 
 
-def _extract(f_final, frame: Frame, strokes, labels, cut_boundary):
-    """World mesh of f's zero set: supported components, cut along boundary strokes.
+def _extract(f_final, frame: Frame, strokes, labels, cut_boundary, handles: int = 0):
+    """World mesh of f's zero set, its small handles removed
+    (:func:`neural.topology.remove_small_handles` up to ``handles`` cells): supported
+    components, cut along boundary strokes.
 
     Returns ``(V, F, f_np, origin, spacing, n_cut_faces)``; ``f_np`` is signed so that
     the box corner (outside) is positive.
@@ -380,6 +387,9 @@ def _extract(f_final, frame: Frame, strokes, labels, cut_boundary):
     f_np = f_final.detach().to("cpu", torch.float32).numpy()
     if f_np[0, 0, 0] < 0:        # the box corner is outside: make f > 0 outside
         f_np = -f_np
+    if handles > 1:
+        from .topology import remove_small_handles
+        f_np = remove_small_handles(f_np, handles)[0]
     h_world = frame.side / f_np.shape[0]
     origin = frame.box_min + 0.5 * h_world
     V, F = marching_cubes_world(f_np, origin, h_world)

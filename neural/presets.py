@@ -64,6 +64,12 @@ their strokes. So the lumps up to twice the cutoff long are first taken out of t
 normals, which a tube keeps (``attach_normals``: 40 cells at ``default``), and the
 vertices follow them (figures: ``benchmarks/README.md``).
 
+``default`` also takes the small handles out of f's zero set before the extraction
+(``handles``, :mod:`neural.topology`): where f is near zero over a wide area its noise
+pierces the surface with holes a few cells across and spans it with thin strands, tens
+of handles on the surface of a genus-0 sketch, which the fairing turns into pits and
+tears.
+
 Both fit the separately drawn bodies of a connected drawing each on its own, two at
 once (``split_parts``, :mod:`neural.parts`): one field for the whole joins close bodies
 with a web that no stroke holds.
@@ -203,6 +209,13 @@ class FlowConfig:
         cells and the vertices moved to follow them (:func:`neural.attach.normal_faired`):
         ripples up to this long go without the shrinking of a position low-pass; 0 =
         not done. Not in the paper.
+    handles : int
+        Before the extraction, the holes and strands of f's zero set up to ``handles -
+        1`` grid cells across that make handles of the surface are plugged and cut, the
+        rest of the zero set unmoved (:func:`neural.topology.remove_small_handles`;
+        odd, 0 = not done). 5 at ``default``, whose extracted surfaces of genus-0
+        sketches otherwise carry up to tens of such handles; not in ``draft``, whose
+        cells are twice as large. Not in the paper.
     subdivide : int
         Rounds (at most :data:`MAX_SUBDIVIDE`) of curved 1-to-4 subdivision of the final
         mesh (:func:`curvenet.core.geometry.subdivide_curved`): the new vertices on the
@@ -254,6 +267,7 @@ class FlowConfig:
     attach_band: float = 0.0
     attach_reach: float = 3.0
     attach_normals: float = 0.0
+    handles: int = 0
     subdivide: int = 0
     split_parts: int = 0
 
@@ -270,7 +284,7 @@ PRESETS: dict[str, FlowConfig] = {
     "default": FlowConfig(steps=140, w_smooth=0.1, polish=4, polish_rounds=4,
                           polish_strip=1.0, average_from=0.6, attach=20.0,
                           attach_band=0.005, attach_reach=6.0, attach_normals=40.0,
-                          subdivide=1, split_parts=1),
+                          handles=5, subdivide=1, split_parts=1),
     "paper": FlowConfig(res=256, width=256, hidden_layers=4, n_stroke=10000, n_surface=15000,
                         n_volume=15000, init_steps=200, steps=800, lr=5e-5,
                         geometric_init_steps=0),
@@ -330,6 +344,8 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
     if int(cfg.subdivide) != cfg.subdivide or not 0 <= cfg.subdivide <= MAX_SUBDIVIDE:
         raise ValueError(f"subdivide must be an integer in [0, {MAX_SUBDIVIDE}], "
                          f"got {cfg.subdivide!r}")
+    if int(cfg.handles) != cfg.handles or cfg.handles < 0 or (cfg.handles > 0 and cfg.handles % 2 == 0):
+        raise ValueError(f"handles must be 0 or an odd positive integer, got {cfg.handles!r}")
     if cfg.res < 8:
         raise ValueError(f"res must be at least 8, got {cfg.res}")
     if cfg.res > MAX_RES:
