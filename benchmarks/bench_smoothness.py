@@ -21,8 +21,11 @@ centres, in thousandths; ``_away``: the median over the centres farther than the
 ball's radius from every stroke, where a crease or a pull at a stroke is not in the
 ball); then the neural surface against the classical one as the
 reference (:func:`curvenet.evaluate.evaluate_mesh`, F-score at 1% and 2% of the
-reference's longest side). The classical route is the reference only where it holds
-its strokes (``classical_fid`` near 1) and covers the shape; the table says which.
+reference's longest side), and the Euler characteristic ``V - E + F`` of each surface
+(its vertices merged where they coincide: 2 for a closed genus-0 surface, 2 less for
+each handle, 2 more for each extra piece). The classical route is the reference only
+where it holds its strokes (``classical_fid`` near 1) and covers the shape; the table
+says which.
 """
 
 from __future__ import annotations
@@ -44,7 +47,8 @@ SETS = {"cassie": ("sketches/cassie/curves", ".curves"), "networks": ("networks"
         "vns": ("sketches/vns", ".obj")}
 COLUMNS = ("sketch", "classical_s", "classical_fid", "classical_rough", "classical_rough90",
            "classical_rough_away", "neural_s", "neural_fid", "neural_rough", "neural_rough90",
-           "neural_rough_away", "f1_vs_classical", "f2_vs_classical")
+           "neural_rough_away", "f1_vs_classical", "f2_vs_classical", "classical_euler",
+           "neural_euler")
 
 
 def _measure(res):
@@ -55,8 +59,10 @@ def _measure(res):
     r = roughness(res.mesh)
     samples = densify_polylines(res.sketch.strokes, r["radius"] / 4)[0]
     away = cKDTree(samples).query(r["points"])[0] > r["radius"]
+    import trimesh
+    euler = trimesh.Trimesh(res.mesh.vertices, res.mesh.faces).euler_number
     return (fid, 1000 * r["median"], 1000 * r["p90"],
-            1000 * np.median(r["values"][away]) if away.any() else float("nan"))
+            1000 * np.median(r["values"][away]) if away.any() else float("nan"), euler)
 
 
 def _row(name: str, path: Path, quality: str, meshes: Path | None = None,
@@ -75,7 +81,8 @@ def _row(name: str, path: Path, quality: str, meshes: Path | None = None,
               for th in (0.01, 0.02))
     return dict(zip(COLUMNS, (name, f"{t_c:.1f}", f"{c[0]:.3f}", f"{c[1]:.2f}", f"{c[2]:.2f}",
                               f"{c[3]:.2f}", f"{t_n:.1f}", f"{n[0]:.3f}", f"{n[1]:.2f}",
-                              f"{n[2]:.2f}", f"{n[3]:.2f}", f"{f1:.3f}", f"{f2:.3f}")))
+                              f"{n[2]:.2f}", f"{n[3]:.2f}", f"{f1:.3f}", f"{f2:.3f}",
+                              str(c[4]), str(n[4]))))
 
 
 def _paths(names):
