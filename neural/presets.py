@@ -344,7 +344,8 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
     if int(cfg.subdivide) != cfg.subdivide or not 0 <= cfg.subdivide <= MAX_SUBDIVIDE:
         raise ValueError(f"subdivide must be an integer in [0, {MAX_SUBDIVIDE}], "
                          f"got {cfg.subdivide!r}")
-    if int(cfg.handles) != cfg.handles or cfg.handles < 0 or (cfg.handles > 0 and cfg.handles % 2 == 0):
+    h = cfg.handles
+    if int(h) != h or h < 0 or (h > 0 and h % 2 == 0):
         raise ValueError(f"handles must be 0 or an odd positive integer, got {cfg.handles!r}")
     if cfg.res < 8:
         raise ValueError(f"res must be at least 8, got {cfg.res}")

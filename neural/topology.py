@@ -32,11 +32,11 @@ cubes joins it to the solid across faces only; a full one for a cut, so that it 
 the air across edges and corners too); every other value of ``f`` is kept.
 
 Digital topology: the solid is 6-connected and the air 26-connected. Marching cubes
-decides the ambiguous faces by the values and agrees with that pairing only mostly,
-so some handles stay (``benchmarks/README.md`` counts them). The closing cubes grow from 3 to ``size``
-cells (a large hole is closed best after the small ones around it), and no step undoes
-a voxel an earlier one changed (a plug is a thin sheet, a cut a small hole: the cut or
-plug steps after it would take it for noise).
+decides the ambiguous faces by the values and agrees with that pairing only mostly, so
+some handles stay (``benchmarks/README.md`` counts them). The closing cubes grow from 3
+to ``size`` cells (a large hole is closed best after the small ones around it), and no
+step undoes a voxel an earlier one changed (a plug is a thin sheet, a cut a small hole:
+the cut or plug steps after it would take it for noise).
 
 References
 ----------
