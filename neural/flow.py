@@ -290,7 +290,8 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
     mesh = _extract(f_final, fit.frame, strokes, labels, cut_boundary, cfg.handles)
     polish = None
     if cfg.polish > 0 and not interrupted:
-        mesh, polish = _polished(fit, f_final, mesh, strokes, labels, cut_boundary)
+        mesh, polish = _polished(fit, f_final, mesh, strokes, labels, cut_boundary,
+                                 cfg.handles)
     V, F, f_np, origin, h_world, n_cut = mesh
     attach = None
     if cfg.attach > 0 and not interrupted and len(F):
@@ -321,10 +322,11 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
                       history=fit.history)
 
 
-def _polished(fit: FlowFit, f, mesh, strokes, labels, cut_boundary):
+def _polished(fit: FlowFit, f, mesh, strokes, labels, cut_boundary, handles: int = 0):
     """The polished surface (:meth:`FlowFit.polish`) if it holds as much of the strokes.
 
-    ``mesh`` is :func:`_extract`'s tuple for the last step's ``f``. The re-integration
+    ``mesh`` is :func:`_extract`'s tuple for the last step's ``f``, and the polished f is
+    extracted the same way (``handles`` as there). The re-integration
     removes Monte-Carlo noise and, with the strip, the shrinking of the surface between
     smooth strokes; where the strokes' extra density is what holds the surface on them
     (open rims, sparse sketches) it moves the surface off them instead. So the polished
@@ -333,8 +335,7 @@ def _polished(fit: FlowFit, f, mesh, strokes, labels, cut_boundary):
 
     Returns ``(mesh, {"fidelity": [last step's, polished], "kept": bool})``.
     """
-    polished = _extract(fit.polish(f), fit.frame, strokes, labels, cut_boundary,
-                        fit.cfg.handles)
+    polished = _extract(fit.polish(f), fit.frame, strokes, labels, cut_boundary, handles)
     fidelity = [_fidelity(m[0], m[1], strokes) for m in (mesh, polished)]
     kept = fidelity[1] >= fidelity[0]
     return (polished if kept else mesh), {"fidelity": fidelity, "kept": kept}
