@@ -97,7 +97,18 @@ def _three_balls():
     return sum((_ball(np.array([2.2 * k, 0, 0])) for k in range(3)), [])
 
 
-def test_ctrl_c_stops_the_running_parts_and_skips_the_rest(monkeypatch):
+@pytest.fixture
+def python_sigint():
+    """Python's own SIGINT handler for the test: a background job (``cmd &`` in a
+    script) starts with SIGINT ignored, and then ``_thread.interrupt_main`` does
+    nothing."""
+    import signal
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, old)
+
+
+def test_ctrl_c_stops_the_running_parts_and_skips_the_rest(monkeypatch, python_sigint):
     import _thread
     import time
 
