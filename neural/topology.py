@@ -127,9 +127,10 @@ def simple_points(solid: np.ndarray, index: np.ndarray) -> np.ndarray:
     lab = _component_labels(air, _ADJ26)
     n_air = (air & (lab == np.arange(26))).sum(axis=1)
     full = nb[:, _N18]
-    lab = np.where(full & _FACE_OF_18, _component_labels(full, _ADJ6_IN_18), 99)
+    none = len(_N18)                              # the label of a position off the solid
+    lab = np.where(_FACE_OF_18, _component_labels(full, _ADJ6_IN_18), none)
     lab = np.sort(lab, axis=1)                    # the distinct labels at the six faces
-    n_solid = (lab[:, 0] != 99) + ((np.diff(lab, axis=1) != 0) & (lab[:, 1:] != 99)).sum(axis=1)
+    n_solid = (lab[:, 0] != none) + ((np.diff(lab, axis=1) != 0) & (lab[:, 1:] != none)).sum(axis=1)
     return (n_air == 1) & (n_solid == 1)
 
 
@@ -167,23 +168,20 @@ def _close_small(f: np.ndarray, size: int, kept: np.ndarray, may_split: bool) ->
     plugs, n_plugs = ndimage.label(plug)
     if not n_plugs:
         return plug
-    # a plug that touches two pieces of the solid joins them; one that touches two pieces
-    # of the rest of the air that were one splits the air
-    after, _ = ndimage.label(~solid & ~plug)
+    # a plug that touches two pieces of the solid joins them
     touch = ndimage.maximum_filter(plugs, footprint=ndimage.generate_binary_structure(3, 1))
     rim = ndimage.binary_dilation(plug)
-    bad = []
-    for side, labels in ((solid, ndimage.label(solid)[0]), (~solid & ~plug, after)):
-        at = rim & side
-        pairs = np.unique(np.stack([touch[at], labels[at], air[at]], axis=1), axis=0)
-        # per plug: distinct pieces touched, and (air only) distinct pieces they were in
-        n_touched = np.bincount(pairs[:, 0], minlength=n_plugs + 1)
-        if side is solid:
-            bad.append(n_touched > 1)
-        else:
-            was = np.unique(pairs[:, [0, 2]], axis=0)
-            bad.append(n_touched > np.bincount(was[:, 0], minlength=n_plugs + 1))
-    return plug & ~np.isin(plugs, np.flatnonzero(bad[0] | (False if may_split else bad[1])))
+    at = rim & solid
+    pairs = np.unique(np.stack([touch[at], ndimage.label(solid)[0][at]], axis=1), axis=0)
+    bad = np.bincount(pairs[:, 0], minlength=n_plugs + 1) > 1
+    if not may_split:     # one that touches two pieces of the rest of the air that were one
+        at = rim & ~solid & ~plug
+        now = np.unique(np.stack([touch[at], ndimage.label(~solid & ~plug)[0][at], air[at]],
+                                 axis=1), axis=0)
+        was = np.unique(now[:, [0, 2]], axis=0)
+        bad |= (np.bincount(now[:, 0], minlength=n_plugs + 1)
+                > np.bincount(was[:, 0], minlength=n_plugs + 1))
+    return plug & ~np.isin(plugs, np.flatnonzero(bad))
 
 
 def remove_small_handles(f, size: int = 5) -> tuple[np.ndarray, dict]:
@@ -212,17 +210,18 @@ def remove_small_handles(f, size: int = 5) -> tuple[np.ndarray, dict]:
     if int(size) != size or size < 0 or (size > 1 and size % 2 == 0):
         raise ValueError(f"size must be 0, 1 or an odd integer >= 3, got {size!r}")
     out = np.array(f)
-    solid = np.argwhere(out < 0)
-    if size < 3 or not len(solid) or (out < 0).all():
+    inside = out < 0
+    if size < 3 or not inside.any() or inside.all():
         return out, {"plugged": 0, "cut": 0}
     # nothing changes farther than the cube from the solid: work in its box, with air
     # all round it (one outside, as in the whole grid)
+    solid = np.argwhere(inside)
     lo = np.maximum(solid.min(axis=0) - size - 1, 0)
     hi = np.minimum(solid.max(axis=0) + size + 2, out.shape)
     box = tuple(slice(a, b) for a, b in zip(lo, hi))
     f = out[box]
     moved = np.zeros(f.shape, bool)      # what no later step may undo
-    plugged = cut = 0
+    count = {1: 0, -1: 0}                # plugged, cut
     for s in range(3, int(size) + 1, 2):
         for sign in (1, -1):
             g = sign * f
@@ -232,9 +231,6 @@ def remove_small_handles(f, size: int = 5) -> tuple[np.ndarray, dict]:
                 g[plug] = -value * float(np.median(np.abs(g[g < 0])))
                 f = sign * g
                 moved |= plug
-            if sign > 0:
-                plugged += int(plug.sum())
-            else:
-                cut += int(plug.sum())
+                count[sign] += int(plug.sum())
     out[box] = f
-    return out, {"plugged": plugged, "cut": cut}
+    return out, {"plugged": count[1], "cut": count[-1]}
