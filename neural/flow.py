@@ -66,10 +66,11 @@ Engineering choices (documented deviations / gap fills)
   the last steps' noise than the last step's network, and it starts from the running
   mean of those steps' f (Polyak averaging of the field): the last step's zero set
   carries its splat's Monte-Carlo bumps, and a round of the polish moves a surface
-  only part of the way, so it keeps much of them. The polished
-  surface is returned only when its stroke fidelity is at least the last step's
-  (:func:`_polished`): on sketches whose surface the strokes' extra density holds
-  in place (open rims), the re-integration moves it off them.
+  only part of the way, so it keeps much of them. Both surfaces are faired
+  (``attach``, below) and the polished one is returned only when its stroke fidelity
+  is then at least the last step's, less :data:`POLISH_SLACK` (:func:`_polished`): on
+  sketches whose surface the strokes' extra density holds in place (open rims), the
+  re-integration moves it off them, farther than the fairing's pull reaches.
 * Final mesh: pieces of the zero set with no stroke within 4 grid cells are
   dropped (spurious level-set components of the periodic f), and after the fairing
   the closed pieces whose strokes the other pieces already carry within the stroke
@@ -124,7 +125,15 @@ from .frame import Frame
 from .presets import FlowConfig, get_config
 from .training import torch_device, train
 
-__all__ = ["FlowResult", "fit_flow_surface", "fit_strokes"]
+__all__ = ["FlowResult", "fit_flow_surface", "fit_strokes", "POLISH_SLACK"]
+
+#: Share of the stroke length the faired polished surface may hold less of than the last
+#: step's and still be returned: a few stroke samples at the edge of the fidelity's
+#: tolerance, less than the difference of one field's Monte-Carlo noise to the next.
+POLISH_SLACK = 0.01
+#: The fairing also carries the surface onto some stroke samples beyond its pull's reach:
+#: up to this share of the stroke length more than the samples within reach.
+_BEYOND_REACH = 0.05
 
 
 @dataclass(repr=False, kw_only=True)
@@ -287,18 +296,16 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
 
     t0 = time.perf_counter()
     f_final = run.best if run.best is not None else fit.solve_strokes_only()
+    anchor_points = None if anchors is None else anchors[0]
     mesh = _extract(f_final, fit.frame, strokes, labels, cut_boundary, cfg.handles)
-    polish = None
-    if cfg.polish > 0 and not interrupted:
-        mesh, polish = _polished(fit, f_final, mesh, strokes, labels, cut_boundary,
-                                 cfg.handles)
+    polish = attach = None
+    if not interrupted:
+        done = _faired(mesh, strokes, cfg, anchor_points)
+        if cfg.polish > 0:
+            done, polish = _polished(fit, f_final, done, strokes, labels, cut_boundary, cfg,
+                                     anchor_points)
+        mesh, attach = done[:2]
     V, F, f_np, origin, h_world, n_cut = mesh
-    attach = None
-    if cfg.attach > 0 and not interrupted and len(F):
-        # the polish measured the fidelity of the mesh it returned
-        before = None if polish is None else polish["fidelity"][int(polish["kept"])]
-        V, attach = _attached(V, F, strokes, h_world, cfg, before,
-                              None if anchors is None else anchors[0])
     n_bubbles = 0
     if anchors is None and len(F):
         from curvenet.core.fidelity import FIDELITY_TOL_REL
@@ -322,30 +329,54 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
                       history=fit.history)
 
 
-def _polished(fit: FlowFit, f, mesh, strokes, labels, cut_boundary, handles: int = 0):
-    """The polished surface (:meth:`FlowFit.polish`) if it holds as much of the strokes.
+def _faired(mesh, strokes, cfg: FlowConfig, anchors=None):
+    """``mesh`` (:func:`_extract`'s tuple) faired onto its strokes (:func:`_attached`) when
+    ``cfg.attach`` > 0: ``(mesh, attach report or None, stroke fidelity)``."""
+    V, F = mesh[:2]
+    if cfg.attach > 0 and len(F):
+        V, attach = _attached(V, F, strokes, mesh[4], cfg, anchors)
+        return (V,) + tuple(mesh[1:]), attach, attach["fidelity"][int(attach["kept"])]
+    return mesh, None, _fidelity(V, F, strokes)
 
-    ``mesh`` is :func:`_extract`'s tuple for the last step's ``f``, and the polished f is
-    extracted the same way (``handles`` as there). The re-integration
+
+def _polished(fit: FlowFit, f, done, strokes, labels, cut_boundary, cfg: FlowConfig,
+              anchors=None):
+    """The polished surface (:meth:`FlowFit.polish`) if, faired, it holds as much of the
+    strokes.
+
+    ``done`` is :func:`_faired`'s triple for the last step's ``f``; the polished f is
+    extracted (``cfg.handles`` as there) and faired the same way. The re-integration
     removes Monte-Carlo noise and, with the strip, the shrinking of the surface between
     smooth strokes; where the strokes' extra density is what holds the surface on them
-    (open rims, sparse sketches) it moves the surface off them instead. So the polished
-    surface is kept only when its stroke fidelity
-    (:func:`curvenet.core.fidelity.sketch_fidelity`) is at least that of ``mesh``.
+    (open rims, sparse sketches) it moves the surface off them instead, farther than the
+    fairing's pull reaches. So the polished surface is kept only when its stroke
+    fidelity (:func:`curvenet.core.fidelity.sketch_fidelity`) after the fairing is at
+    least that of ``done`` less :data:`POLISH_SLACK`: the surfaces compared are the
+    ones that would be returned, and a difference of a few samples is no reason to
+    return the noisier field.
 
-    Returns ``(mesh, {"fidelity": [last step's, polished], "kept": bool})``.
+    A polished surface that leaves so much of the strokes out of the fairing's reach that
+    it cannot be kept is not faired (its fidelity in the report is then the extracted
+    surface's).
+
+    Returns ``(the kept triple, {"fidelity": [last step's, polished], "kept": bool})``.
     """
-    polished = _extract(fit.polish(f), fit.frame, strokes, labels, cut_boundary, handles)
-    fidelity = [_fidelity(m[0], m[1], strokes) for m in (mesh, polished)]
-    kept = fidelity[1] >= fidelity[0]
-    return (polished if kept else mesh), {"fidelity": fidelity, "kept": kept}
+    mesh = _extract(fit.polish(f), fit.frame, strokes, labels, cut_boundary, cfg.handles)
+    V, F, h_world = mesh[0], mesh[1], mesh[4]
+    if cfg.attach > 0 and len(F) and _fidelity(V, F, strokes, cfg.attach_reach * h_world) \
+            < done[2] - POLISH_SLACK - _BEYOND_REACH:
+        polished = (mesh, None, _fidelity(V, F, strokes))
+    else:
+        polished = _faired(mesh, strokes, cfg, anchors)
+    fidelity = [done[2], polished[2]]
+    kept = fidelity[1] >= fidelity[0] - POLISH_SLACK
+    return (polished if kept else done), {"fidelity": fidelity, "kept": kept}
 
 
-def _attached(V, F, strokes, h_world, cfg: FlowConfig, before: float | None = None,
-              anchors=None):
+def _attached(V, F, strokes, h_world, cfg: FlowConfig, anchors=None):
     """The mesh faired onto its strokes (:func:`neural.attach.attach_to_strokes`) if it
     holds at least as much of them; ``(V, {"fidelity": [before, after], "kept": bool,
-    "samples", "pulled", "held"})``. ``before``: the stroke fidelity of ``(V, F)`` when known.
+    "samples", "pulled", "held"})``.
 
     ``anchors`` ((m, 3) float64, a hybrid fill's anchor points) pull like stroke samples,
     and nothing is held to the band: a fill's strokes are the loose strokes no patch
@@ -357,19 +388,21 @@ def _attached(V, F, strokes, h_world, cfg: FlowConfig, before: float | None = No
                                weight=cfg.attach_weight, band=band, reach=cfg.attach_reach,
                                normals=cfg.attach_normals,
                                points=anchors)
-    if before is None:
-        before = _fidelity(V, F, strokes)
-    fidelity = [before, _fidelity(X, F, strokes)]
+    fidelity = [_fidelity(V, F, strokes), _fidelity(X, F, strokes)]
     kept = bool(np.isfinite(X).all() and fidelity[1] >= fidelity[0])
     return (X if kept else V), dict(rep, fidelity=fidelity, kept=kept)
 
 
-def _fidelity(V, F, strokes) -> float:
-    """Stroke fidelity of the mesh ``(V, F)`` (0 when it has no triangle of positive area)."""
+def _fidelity(V, F, strokes, within: float | None = None) -> float:
+    """Stroke fidelity of the mesh ``(V, F)`` (0 when it has no triangle of positive area);
+    with ``within`` (model units), the share of stroke length within that distance of it
+    instead of the fidelity's tolerance."""
     from curvenet.core.errors import InvalidParameterError
-    from curvenet.core.fidelity import sketch_fidelity
+    from curvenet.core.fidelity import FIDELITY_TOL_REL, sketch_fidelity
+    tol = FIDELITY_TOL_REL if within is None else min(within / bbox_diagonal(list(strokes)),
+                                                      0.99)
     try:
-        return sketch_fidelity((V, F), strokes)["surface"]
+        return sketch_fidelity((V, F), strokes, tol=tol)["surface"]
     except InvalidParameterError:          # no faces, or only degenerate ones
         return 0.0
 

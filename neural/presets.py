@@ -38,8 +38,8 @@ from the paper in:
 - ``default`` only, the polish (``polish``, ``polish_rounds``, ``polish_strip``,
   ``average_from``): f re-integrated from the network averaged over the last 40 % of
   the full stage, with the stroke samples in place of the surface samples next to
-  them, returned only when it holds at least as much of the strokes as the last
-  step's surface: the stroke samples splatted on top of the surface ones shrink smooth
+  them, returned only when, both faired, it holds about as much of the strokes as
+  the last step's surface: the stroke samples splatted on top of the surface ones shrink smooth
   surfaces between their strokes, and the polish takes that back where it does not
   move the surface off the strokes.
 
@@ -170,8 +170,9 @@ class FlowConfig:
         After the last step, integrate f again (no gradients) from this many times
         the stroke and surface samples of a step, ``polish_rounds`` times, each round
         drawing its surface samples on the zero set of the one before; 0 keeps the
-        last step's f. The polished surface is returned only when it holds at least
-        as much of the strokes as the last step's (stroke fidelity, the share of
+        last step's f. Both surfaces are faired (``attach``) and the polished one is
+        returned only when it then holds at least as much of the strokes as the last
+        step's, less ``neural.flow.POLISH_SLACK`` (stroke fidelity, the share of
         stroke length within 1 % of the strokes' diagonal); ``report["polish"]``
         gives both figures. Not in the paper (see the notes above: ``default``).
     polish_rounds : int

@@ -203,28 +203,78 @@ def _sphere_f(frame, res, radius):
                            dtype=torch.float32)
 
 
+class _PolishFit:
+    """A stand-in fit whose polish returns the sphere of radius ``polished``."""
+    frame = Frame.from_points(np.vstack(_circles()), 0.2)
+
+    def __init__(self, polished):
+        self.polished = polished
+
+    def polish(self, f):
+        return _sphere_f(self.frame, 48, self.polished)
+
+
 @pytest.mark.parametrize("last, polished, kept", [(1.0, 0.8, False), (0.8, 1.0, True),
                                                    (1.0, 1.0, True)])
 def test_polish_is_kept_only_when_it_holds_the_strokes(last, polished, kept):
     # the strokes lie on the unit sphere: a polished f whose zero set is the sphere of
     # radius 0.8 is off them and the last step's surface is returned; the other way round
     # (and on a tie) the polished one
-    class Fit:
-        frame = Frame.from_points(np.vstack(_circles()), 0.2)
-
-        def polish(self, f):
-            return _sphere_f(self.frame, 48, polished)
-
-    fit, strokes = Fit(), _circles()
-    labels = ["crease"] * 3
-    mesh = flow._extract(_sphere_f(fit.frame, 48, last), fit.frame, strokes, labels, True)
-    (V, _F, *_), info = flow._polished(fit, None, mesh, strokes, labels, True)
+    fit, strokes, labels = _PolishFit(polished), _circles(), ["crease"] * 3
+    cfg = get_config("draft", attach=0.0)
+    done = flow._faired(flow._extract(_sphere_f(fit.frame, 48, last), fit.frame, strokes,
+                                      labels, True), strokes, cfg)
+    ((V, _F, *_), attach, _), info = flow._polished(fit, None, done, strokes, labels, True,
+                                                    cfg)
+    assert attach is None
     assert info["kept"] is kept
     on, off = (0, 1) if last == 1.0 else (1, 0)
     assert info["fidelity"][on] == 1.0
     assert info["fidelity"][off] == 1.0 if last == polished else info["fidelity"][off] < 0.01
     r = np.linalg.norm(V, axis=1)
     assert abs(r.mean() - (polished if kept else last)) < 0.01
+
+
+@pytest.mark.parametrize("polished, kept", [(0.94, True), (0.8, False)])
+def test_polish_is_judged_after_the_fairing(monkeypatch, polished, kept):
+    # a polished sphere of radius 0.94 lies off the unit circles by more than the
+    # fidelity's tolerance and within the fairing's reach: as extracted it holds none of
+    # them, faired it holds them all as the last step's surface does, and it is kept;
+    # at radius 0.8, out of the fairing's reach, it is not
+    fit, strokes, labels = _PolishFit(polished), _circles(), ["crease"] * 3
+    cfg = get_config("draft")
+    raw = flow._extract(fit.polish(None), fit.frame, strokes, labels, True)
+    assert flow._fidelity(raw[0], raw[1], strokes) < 0.05
+    done = flow._faired(flow._extract(_sphere_f(fit.frame, 48, 1.0), fit.frame, strokes,
+                                      labels, True), strokes, cfg)
+    calls = []
+    attached = flow._attached
+    monkeypatch.setattr(flow, "_attached", lambda *a: calls.append(1) or attached(*a))
+    (mesh, attach, _), info = flow._polished(fit, None, done, strokes, labels, True, cfg)
+    assert info == {"fidelity": [1.0, 1.0 if kept else 0.0], "kept": kept}
+    assert (mesh[2] is done[0][2]) is not kept            # whose f's grid
+    assert len(calls) == kept         # out of the fairing's reach: not faired at all
+    radius = np.linalg.norm(mesh[0], axis=1)
+    if kept:                            # pulled from 0.94 onto the circles
+        assert attach["fidelity"][0] < 0.05 and (np.abs(radius - 1.0) < 0.02).mean() > 0.3
+    else:
+        assert np.abs(radius - 1.0).max() < 0.01
+
+
+@pytest.mark.parametrize("polished, kept", [(0.995, True), (0.985, False)])
+def test_polish_may_hold_a_little_less_of_the_strokes(monkeypatch, polished, kept):
+    # faired, the polished surface is returned while it holds no less than the last
+    # step's (1.0 here) by more than POLISH_SLACK
+    mesh = ("polished", np.array([[0, 1, 2]]), None, None, 0.1)
+    monkeypatch.setattr(flow, "_extract", lambda *a: mesh)
+    monkeypatch.setattr(flow, "_fidelity", lambda *a: 1.0)          # all within reach
+    monkeypatch.setattr(flow, "_faired", lambda mesh, *a: (mesh, None, polished))
+    done = (("last",), None, 1.0)
+    chosen, info = flow._polished(_PolishFit(1.0), None, done, [], [], True,
+                                  get_config("default"))
+    assert flow.POLISH_SLACK == 0.01
+    assert info == {"fidelity": [1.0, polished], "kept": kept}
+    assert chosen[0][0] == ("polished" if kept else "last")
 
 
 def test_dirichlet_boundary_keeps_walls_outside():
