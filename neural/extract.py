@@ -31,7 +31,7 @@ import numpy as np
 import scipy.sparse as sp
 from scipy.spatial import cKDTree
 
-from curvenet.core.geometry import densify_polyline, face_edges
+from curvenet.core.geometry import densify_polyline, face_edges, face_normals_areas
 
 __all__ = ["marching_cubes_world", "face_components", "keep_supported_components",
            "drop_redundant_bubbles", "cut_along_boundary"]
@@ -84,8 +84,13 @@ def _near(vertices, strokes, tol):
     return np.isfinite(d)
 
 
-def keep_supported_components(vertices, faces, strokes, tol):
-    """Drop connected pieces with no vertex within ``tol`` of any stroke.
+def keep_supported_components(vertices, faces, strokes, tol, min_area: float = 0.0):
+    """Drop connected pieces with no vertex within ``tol`` of any stroke, and those whose
+    area is below ``min_area``.
+
+    Marching cubes makes a piece of a few triangles wherever f dips below zero at one
+    node or two: with ``min_area`` one face of the grid's cell, those specks, far below
+    what the grid resolves, go even where they touch a stroke (the largest piece stays).
 
     Returns
     -------
@@ -98,6 +103,9 @@ def keep_supported_components(vertices, faces, strokes, tol):
     face_near = near[faces].any(1)
     good = np.zeros(lab.max() + 1, dtype=bool)
     good[lab[face_near]] = True
+    if min_area > 0:
+        area = np.bincount(lab, face_normals_areas(vertices, faces)[1], minlength=len(good))
+        good &= (area >= min_area) | (area == area.max())
     if not good.any():
         return vertices, faces
     return _compact(vertices, faces[good[lab]])

@@ -72,10 +72,12 @@ Engineering choices (documented deviations / gap fills)
   sketches whose surface the strokes' extra density holds in place (open rims), the
   re-integration moves it off them, farther than the fairing's pull reaches.
 * Final mesh: pieces of the zero set with no stroke within 4 grid cells are
-  dropped (spurious level-set components of the periodic f), and after the fairing
-  the closed pieces whose strokes the other pieces already carry within the stroke
-  fidelity's tolerance (:func:`neural.extract.drop_redundant_bubbles`: the field's
-  small bubbles inside the solid or beside it; not for hybrid fills).
+  dropped (spurious level-set components of the periodic f), and so are the pieces
+  of less area than one face of a grid cell (specks where f dips below zero at a node
+  or two, which carried a stroke sample or two and counted as holding them); after
+  the fairing, the closed pieces whose strokes the other pieces already carry within
+  the stroke fidelity's tolerance (:func:`neural.extract.drop_redundant_bubbles`: the
+  field's small bubbles inside the solid or beside it; not for hybrid fills).
 * ``attach > 0`` (draft, default): the extracted mesh is faired and pulled onto the
   strokes near it (:mod:`neural.attach`, a stroke-constrained bi-Laplacian low-pass of
   the vertices, at ``default`` after a low-pass of their normals that the vertices
@@ -427,7 +429,7 @@ def _extract(f_final, frame: Frame, strokes, labels, cut_boundary, handles: int 
     h_world = frame.side / f_np.shape[0]
     origin = frame.box_min + 0.5 * h_world
     V, F = marching_cubes_world(f_np, origin, h_world)
-    V, F = keep_supported_components(V, F, strokes, 4.0 * h_world)
+    V, F = keep_supported_components(V, F, strokes, 4.0 * h_world, h_world ** 2)
     n_before_cut = len(F)
     if cut_boundary and "boundary" in labels:
         V, F = cut_along_boundary(V, F, [s for s, lab in zip(strokes, labels) if lab == "boundary"],

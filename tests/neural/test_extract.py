@@ -45,6 +45,22 @@ def test_keep_supported_components_drops_far_piece():
     assert len(F2) == len(a.faces) and np.abs(np.linalg.norm(V2, axis=1) - 1).max() < 1e-9
 
 
+def test_specks_under_one_cell_face_are_dropped_even_on_a_stroke():
+    # a ball of radius 0.02 on the stroke (area 0.005) goes when the cell is 0.1 (face
+    # 0.01) and stays when it is 0.05; a lone piece is never dropped for its size
+    a = trimesh.creation.icosphere(2, radius=1.0)
+    speck = trimesh.creation.icosphere(1, radius=0.02)
+    speck.apply_translation([1.5, 0, 0])
+    V = np.vstack([a.vertices, speck.vertices])
+    F = np.vstack([a.faces, speck.faces + len(a.vertices)])
+    stroke = np.array([[1.0, 0, 0], [1.5, 0, 0]])
+    assert len(keep_supported_components(V, F, [stroke], 0.05, 0.05 ** 2)[1]) == len(F)
+    V2, F2 = keep_supported_components(V, F, [stroke], 0.05, 0.1 ** 2)
+    assert len(F2) == len(a.faces) and np.abs(np.linalg.norm(V2, axis=1) - 1).max() < 1e-9
+    V3, F3 = keep_supported_components(speck.vertices, speck.faces, [stroke], 0.05, 1.0)
+    assert len(F3) == len(speck.faces)
+
+
 def test_bubbles_whose_strokes_the_surface_carries_are_dropped_a_drawn_part_stays():
     """A unit sphere with great-circle strokes, a bubble inside it touching a stroke, one
     beside it, and a small ball drawn with a stroke of its own: the two bubbles go, the
