@@ -302,10 +302,11 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
     mesh = _extract(f_final, fit.frame, strokes, labels, cut_boundary, cfg.handles)
     polish = attach = None
     if not interrupted:
-        done = _faired(mesh, strokes, cfg, anchor_points)
         if cfg.polish > 0:
-            done, polish = _polished(fit, f_final, done, strokes, labels, cut_boundary, cfg,
+            done, polish = _polished(fit, f_final, mesh, strokes, labels, cut_boundary, cfg,
                                      anchor_points)
+        else:
+            done = _faired(mesh, strokes, cfg, anchor_points)
         mesh, attach = done[:2]
     V, F, f_np, origin, h_world, n_cut = mesh
     n_bubbles = 0
@@ -341,38 +342,54 @@ def _faired(mesh, strokes, cfg: FlowConfig, anchors=None):
     return mesh, None, _fidelity(V, F, strokes)
 
 
-def _polished(fit: FlowFit, f, done, strokes, labels, cut_boundary, cfg: FlowConfig,
+def _polished(fit: FlowFit, f, mesh, strokes, labels, cut_boundary, cfg: FlowConfig,
               anchors=None):
     """The polished surface (:meth:`FlowFit.polish`) if, faired, it holds as much of the
-    strokes.
+    strokes as the last step's surface faired.
 
-    ``done`` is :func:`_faired`'s triple for the last step's ``f``; the polished f is
-    extracted (``cfg.handles`` as there) and faired the same way. The re-integration
-    removes Monte-Carlo noise and, with the strip, the shrinking of the surface between
-    smooth strokes; where the strokes' extra density is what holds the surface on them
-    (open rims, sparse sketches) it moves the surface off them instead, farther than the
-    fairing's pull reaches. So the polished surface is kept only when its stroke
-    fidelity (:func:`curvenet.core.fidelity.sketch_fidelity`) after the fairing is at
-    least that of ``done`` less :data:`POLISH_SLACK`: the surfaces compared are the
-    ones that would be returned, and a difference of a few samples is no reason to
-    return the noisier field.
+    ``mesh`` is :func:`_extract`'s tuple for the last step's ``f``; the polished f is
+    extracted (``cfg.handles`` as there) and both are faired (:func:`_faired`). The
+    re-integration removes Monte-Carlo noise and, with the strip, the shrinking of the
+    surface between smooth strokes; where the strokes' extra density is what holds the
+    surface on them (open rims, sparse sketches) it moves the surface off them instead,
+    farther than the fairing's pull reaches. So the polished surface is kept only when
+    its stroke fidelity (:func:`curvenet.core.fidelity.sketch_fidelity`) after the
+    fairing is at least the last step's less :data:`POLISH_SLACK`: the surfaces compared
+    are the ones that would be returned, and a difference of a few samples is no reason
+    to return the noisier field.
 
-    A polished surface that leaves so much of the strokes out of the fairing's reach that
-    it cannot be kept is not faired (its fidelity in the report is then the extracted
-    surface's).
+    A surface is faired only where the choice needs it (:func:`_ceiling`): the polished
+    one not when it cannot reach the last step's extracted fidelity, the last step's not
+    when the faired polished one is within the slack of all it could reach.
 
-    Returns ``(the kept triple, {"fidelity": [last step's, polished], "kept": bool})``.
+    Returns ``(the kept triple of _faired, {"fidelity": [last step's, polished],
+    "faired": [bool, bool], "kept": bool})``: each fidelity as faired, or as extracted
+    where that surface was not faired.
     """
-    mesh = _extract(fit.polish(f), fit.frame, strokes, labels, cut_boundary, cfg.handles)
-    V, F, h_world = mesh[0], mesh[1], mesh[4]
-    if cfg.attach > 0 and len(F) and _fidelity(V, F, strokes, cfg.attach_reach * h_world) \
-            < done[2] - POLISH_SLACK - _BEYOND_REACH:
-        polished = (mesh, None, _fidelity(V, F, strokes))
+    polished = _extract(fit.polish(f), fit.frame, strokes, labels, cut_boundary, cfg.handles)
+    last = _fidelity(mesh[0], mesh[1], strokes)        # the fairing keeps no less
+    out = [None, None]
+    if _ceiling(polished, strokes, cfg) >= last - POLISH_SLACK:
+        out[1] = _faired(polished, strokes, cfg, anchors)
+        if out[1][2] < _ceiling(mesh, strokes, cfg) - POLISH_SLACK:
+            out[0] = _faired(mesh, strokes, cfg, anchors)
     else:
-        polished = _faired(mesh, strokes, cfg, anchors)
-    fidelity = [done[2], polished[2]]
-    kept = fidelity[1] >= fidelity[0] - POLISH_SLACK
-    return (polished if kept else done), {"fidelity": fidelity, "kept": kept}
+        out[0] = _faired(mesh, strokes, cfg, anchors)
+    fidelity = [last if out[0] is None else out[0][2],
+                _fidelity(polished[0], polished[1], strokes) if out[1] is None else out[1][2]]
+    kept = out[1] is not None and fidelity[1] >= fidelity[0] - POLISH_SLACK
+    info = {"fidelity": fidelity, "faired": [o is not None for o in out], "kept": kept}
+    return (out[1] if kept else out[0]), info
+
+
+def _ceiling(mesh, strokes, cfg: FlowConfig) -> float:
+    """The most stroke fidelity that ``mesh`` (:func:`_extract`'s tuple) can have after
+    :func:`_faired`: its own without the fairing; with it, the share of stroke length
+    within the pull's reach (``cfg.attach_reach`` cells) plus :data:`_BEYOND_REACH`."""
+    V, F = mesh[:2]
+    if cfg.attach > 0 and len(F):
+        return min(1.0, _fidelity(V, F, strokes, cfg.attach_reach * mesh[4]) + _BEYOND_REACH)
+    return _fidelity(V, F, strokes)
 
 
 def _attached(V, F, strokes, h_world, cfg: FlowConfig, anchors=None):

@@ -222,9 +222,8 @@ def test_polish_is_kept_only_when_it_holds_the_strokes(last, polished, kept):
     # (and on a tie) the polished one
     fit, strokes, labels = _PolishFit(polished), _circles(), ["crease"] * 3
     cfg = get_config("draft", attach=0.0)
-    done = flow._faired(flow._extract(_sphere_f(fit.frame, 48, last), fit.frame, strokes,
-                                      labels, True), strokes, cfg)
-    ((V, _F, *_), attach, _), info = flow._polished(fit, None, done, strokes, labels, True,
+    mesh = flow._extract(_sphere_f(fit.frame, 48, last), fit.frame, strokes, labels, True)
+    ((V, _F, *_), attach, _), info = flow._polished(fit, None, mesh, strokes, labels, True,
                                                     cfg)
     assert attach is None
     assert info["kept"] is kept
@@ -236,25 +235,23 @@ def test_polish_is_kept_only_when_it_holds_the_strokes(last, polished, kept):
 
 
 @pytest.mark.parametrize("polished, kept", [(0.94, True), (0.8, False)])
-def test_polish_is_judged_after_the_fairing(monkeypatch, polished, kept):
+def test_polish_is_judged_after_the_fairing(polished, kept):
     # a polished sphere of radius 0.94 lies off the unit circles by more than the
     # fidelity's tolerance and within the fairing's reach: as extracted it holds none of
-    # them, faired it holds them all as the last step's surface does, and it is kept;
-    # at radius 0.8, out of the fairing's reach, it is not
+    # them, faired it holds them all as the last step's surface does, and it is kept,
+    # the last step's surface not even faired; at radius 0.8, out of the fairing's
+    # reach, it is neither faired nor kept
     fit, strokes, labels = _PolishFit(polished), _circles(), ["crease"] * 3
     cfg = get_config("draft")
     raw = flow._extract(fit.polish(None), fit.frame, strokes, labels, True)
     assert flow._fidelity(raw[0], raw[1], strokes) < 0.05
-    done = flow._faired(flow._extract(_sphere_f(fit.frame, 48, 1.0), fit.frame, strokes,
-                                      labels, True), strokes, cfg)
-    calls = []
-    attached = flow._attached
-    monkeypatch.setattr(flow, "_attached", lambda *a: calls.append(1) or attached(*a))
-    (mesh, attach, _), info = flow._polished(fit, None, done, strokes, labels, True, cfg)
-    assert info == {"fidelity": [1.0, 1.0 if kept else 0.0], "kept": kept}
-    assert (mesh[2] is done[0][2]) is not kept            # whose f's grid
-    assert len(calls) == kept         # out of the fairing's reach: not faired at all
-    radius = np.linalg.norm(mesh[0], axis=1)
+    mesh = flow._extract(_sphere_f(fit.frame, 48, 1.0), fit.frame, strokes, labels, True)
+    (out, attach, _), info = flow._polished(fit, None, mesh, strokes, labels, True, cfg)
+    assert info == {"fidelity": [1.0, 1.0 if kept else 0.0], "kept": kept,
+                    "faired": [not kept, kept]}
+    assert (out[2] is mesh[2]) is not kept                 # whose f's grid
+    radius = np.linalg.norm(out[0], axis=1)
+    assert attach["kept"]
     if kept:                            # pulled from 0.94 onto the circles
         assert attach["fidelity"][0] < 0.05 and (np.abs(radius - 1.0) < 0.02).mean() > 0.3
     else:
@@ -264,17 +261,19 @@ def test_polish_is_judged_after_the_fairing(monkeypatch, polished, kept):
 @pytest.mark.parametrize("polished, kept", [(0.995, True), (0.985, False)])
 def test_polish_may_hold_a_little_less_of_the_strokes(monkeypatch, polished, kept):
     # faired, the polished surface is returned while it holds no less than the last
-    # step's (1.0 here) by more than POLISH_SLACK
-    mesh = ("polished", np.array([[0, 1, 2]]), None, None, 0.1)
+    # step's (1.0 here) by more than POLISH_SLACK; the last step's surface is faired only
+    # when the polished one falls short of all it could hold
+    last = ("last", np.array([[0, 1, 2]]), None, None, 0.1)
+    mesh = ("polished",) + last[1:]
     monkeypatch.setattr(flow, "_extract", lambda *a: mesh)
-    monkeypatch.setattr(flow, "_fidelity", lambda *a: 1.0)          # all within reach
-    monkeypatch.setattr(flow, "_faired", lambda mesh, *a: (mesh, None, polished))
-    done = (("last",), None, 1.0)
-    chosen, info = flow._polished(_PolishFit(1.0), None, done, [], [], True,
+    monkeypatch.setattr(flow, "_fidelity", lambda *a: 1.0)    # as extracted, and in reach
+    monkeypatch.setattr(flow, "_faired", lambda m, *a: (m, None, polished if m is mesh
+                                                        else 1.0))
+    chosen, info = flow._polished(_PolishFit(1.0), None, last, [], [], True,
                                   get_config("default"))
     assert flow.POLISH_SLACK == 0.01
-    assert info == {"fidelity": [1.0, polished], "kept": kept}
-    assert chosen[0][0] == ("polished" if kept else "last")
+    assert info == {"fidelity": [1.0, polished], "kept": kept, "faired": [not kept, True]}
+    assert chosen[0] is (mesh if kept else last)
 
 
 def test_dirichlet_boundary_keeps_walls_outside():
