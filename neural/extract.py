@@ -33,7 +33,7 @@ from scipy.spatial import cKDTree
 
 from curvenet.core.geometry import densify_polyline, face_edges, face_normals_areas
 
-__all__ = ["marching_cubes_world", "face_components", "keep_supported_components",
+__all__ = ["LONE_NODE_AREA", "marching_cubes_world", "face_components", "keep_supported_components",
            "drop_redundant_bubbles", "cut_along_boundary"]
 
 
@@ -84,12 +84,18 @@ def _near(vertices, strokes, tol):
     return np.isfinite(d)
 
 
+#: The most area, in squared grid cells, of the zero set around one node of the other sign
+#: than its six neighbours: marching cubes puts its vertices on the node's six edges, at
+#: most one cell out, an octahedron of area ``4 sqrt(3)`` at most.
+LONE_NODE_AREA = 4.0 * np.sqrt(3.0)
+
+
 def keep_supported_components(vertices, faces, strokes, tol, min_area: float = 0.0):
     """Drop connected pieces with no vertex within ``tol`` of any stroke, and those whose
     area is below ``min_area``.
 
-    Marching cubes makes a piece of a few triangles wherever f dips below zero at one
-    node or two: with ``min_area`` one face of the grid's cell, those specks, far below
+    Marching cubes makes a piece of a few triangles wherever f dips below zero at a
+    lone node: with ``min_area`` :data:`LONE_NODE_AREA` cell faces, those specks, below
     what the grid resolves, go even where they touch a stroke (the largest piece stays).
 
     Returns

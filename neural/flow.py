@@ -73,8 +73,9 @@ Engineering choices (documented deviations / gap fills)
   re-integration moves it off them, farther than the fairing's pull reaches.
 * Final mesh: pieces of the zero set with no stroke within 4 grid cells are
   dropped (spurious level-set components of the periodic f), and so are the pieces
-  of less area than one face of a grid cell (specks where f dips below zero at a node
-  or two, which carried a stroke sample or two and counted as holding them); after
+  no larger than the zero set around one lone node of the grid
+  (:data:`neural.extract.LONE_NODE_AREA`: specks where f dips below zero at a node,
+  which carried a stroke sample or two and counted as holding them); after
   the fairing, the closed pieces whose strokes the other pieces already carry within
   the stroke fidelity's tolerance (:func:`neural.extract.drop_redundant_bubbles`: the
   field's small bubbles inside the solid or beside it; not for hybrid fills).
@@ -436,7 +437,8 @@ def _extract(f_final, frame: Frame, strokes, labels, cut_boundary, handles: int 
     """
     import torch
 
-    from .extract import cut_along_boundary, keep_supported_components, marching_cubes_world
+    from .extract import (LONE_NODE_AREA, cut_along_boundary, keep_supported_components,
+                          marching_cubes_world)
     f_np = f_final.detach().to("cpu", torch.float32).numpy()
     if f_np[0, 0, 0] < 0:        # the box corner is outside: make f > 0 outside
         f_np = -f_np
@@ -446,7 +448,7 @@ def _extract(f_final, frame: Frame, strokes, labels, cut_boundary, handles: int 
     h_world = frame.side / f_np.shape[0]
     origin = frame.box_min + 0.5 * h_world
     V, F = marching_cubes_world(f_np, origin, h_world)
-    V, F = keep_supported_components(V, F, strokes, 4.0 * h_world, h_world ** 2)
+    V, F = keep_supported_components(V, F, strokes, 4.0 * h_world, LONE_NODE_AREA * h_world ** 2)
     n_before_cut = len(F)
     if cut_boundary and "boundary" in labels:
         V, F = cut_along_boundary(V, F, [s for s, lab in zip(strokes, labels) if lab == "boundary"],

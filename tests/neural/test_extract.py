@@ -1,10 +1,12 @@
 """Marching cubes in world coordinates, component cleanup and the boundary cut."""
 
 import numpy as np
+import pytest
 import trimesh
 
-from curvenet.neural.extract import (cut_along_boundary, drop_redundant_bubbles, face_components,
-                                     keep_supported_components, marching_cubes_world)
+from curvenet.neural.extract import (LONE_NODE_AREA, cut_along_boundary, drop_redundant_bubbles,
+                                     face_components, keep_supported_components,
+                                     marching_cubes_world)
 
 
 def _sphere_grid(n=40, r=0.3):
@@ -59,6 +61,20 @@ def test_specks_under_one_cell_face_are_dropped_even_on_a_stroke():
     assert len(F2) == len(a.faces) and np.abs(np.linalg.norm(V2, axis=1) - 1).max() < 1e-9
     V3, F3 = keep_supported_components(speck.vertices, speck.faces, [stroke], 0.05, 1.0)
     assert len(F3) == len(speck.faces)
+
+
+@pytest.mark.parametrize("depth", [1.0, 1e6])
+def test_lone_node_zero_set_is_within_its_area_bound(depth):
+    # one node far below zero among positive ones: the octahedron of LONE_NODE_AREA;
+    # just below zero, a smaller one
+    from curvenet.core.geometry import face_normals_areas
+    f = np.ones((7, 7, 7))
+    f[3, 3, 3] = -depth
+    V, F = marching_cubes_world(f, np.zeros(3), 0.5)
+    area = face_normals_areas(V, F)[1].sum() / 0.5 ** 2
+    assert len(np.unique(face_components(F, len(V)))) == 1
+    assert area <= LONE_NODE_AREA * (1 + 1e-9)
+    assert area > 0.99 * LONE_NODE_AREA if depth > 1 else area < 0.5 * LONE_NODE_AREA
 
 
 def test_bubbles_whose_strokes_the_surface_carries_are_dropped_a_drawn_part_stays():
