@@ -34,33 +34,36 @@ def test_no_crossing_gives_empty_mesh():
     assert V.shape == (0, 3) and F.shape == (0, 3)
 
 
-def test_keep_supported_components_drops_far_piece():
+def _unit_sphere_and_ball(radius, x, subdivisions=2):
+    """The unit icosphere and a ball of ``radius`` centred at ``(x, 0, 0)``: the sphere's
+    face count and the two pieces' ``(V, F)``."""
     a = trimesh.creation.icosphere(2, radius=1.0)
-    b = trimesh.creation.icosphere(2, radius=0.5)
-    b.apply_translation([5.0, 0, 0])
+    b = trimesh.creation.icosphere(subdivisions, radius=radius)
+    b.apply_translation([x, 0, 0])
     V = np.vstack([a.vertices, b.vertices])
-    F = np.vstack([a.faces, b.faces + len(a.vertices)])
+    return len(a.faces), V, np.vstack([a.faces, b.faces + len(a.vertices)])
+
+
+def test_keep_supported_components_drops_far_piece():
+    n_sphere, V, F = _unit_sphere_and_ball(0.5, 5.0)
     assert len(np.unique(face_components(F, len(V)))) == 2
     t = np.linspace(0, 2 * np.pi, 50)
     stroke = np.c_[np.cos(t), np.sin(t), 0 * t]
     V2, F2 = keep_supported_components(V, F, [stroke], 0.05)
-    assert len(F2) == len(a.faces) and np.abs(np.linalg.norm(V2, axis=1) - 1).max() < 1e-9
+    assert len(F2) == n_sphere and np.abs(np.linalg.norm(V2, axis=1) - 1).max() < 1e-9
 
 
 def test_specks_under_one_cell_face_are_dropped_even_on_a_stroke():
     # a ball of radius 0.02 on the stroke (area 0.005) goes when the cell is 0.1 (face
     # 0.01) and stays when it is 0.05; a lone piece is never dropped for its size
-    a = trimesh.creation.icosphere(2, radius=1.0)
-    speck = trimesh.creation.icosphere(1, radius=0.02)
-    speck.apply_translation([1.5, 0, 0])
-    V = np.vstack([a.vertices, speck.vertices])
-    F = np.vstack([a.faces, speck.faces + len(a.vertices)])
+    n_sphere, V, F = _unit_sphere_and_ball(0.02, 1.5, subdivisions=1)
     stroke = np.array([[1.0, 0, 0], [1.5, 0, 0]])
     assert len(keep_supported_components(V, F, [stroke], 0.05, 0.05 ** 2)[1]) == len(F)
     V2, F2 = keep_supported_components(V, F, [stroke], 0.05, 0.1 ** 2)
-    assert len(F2) == len(a.faces) and np.abs(np.linalg.norm(V2, axis=1) - 1).max() < 1e-9
-    V3, F3 = keep_supported_components(speck.vertices, speck.faces, [stroke], 0.05, 1.0)
-    assert len(F3) == len(speck.faces)
+    assert len(F2) == n_sphere and np.abs(np.linalg.norm(V2, axis=1) - 1).max() < 1e-9
+    speck = F[n_sphere:] - F[n_sphere:].min()
+    V3, F3 = keep_supported_components(V[F[n_sphere:].min():], speck, [stroke], 0.05, 1.0)
+    assert len(F3) == len(speck)
 
 
 @pytest.mark.parametrize("depth", [1.0, 1e6])
