@@ -334,14 +334,15 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
                       history=fit.history)
 
 
-def _faired(mesh, strokes, cfg: FlowConfig, anchors=None):
+def _faired(mesh, strokes, cfg: FlowConfig, anchors=None, before: float | None = None):
     """``mesh`` (:func:`_extract`'s tuple) faired onto its strokes (:func:`_attached`) when
-    ``cfg.attach`` > 0: ``(mesh, attach report or None, stroke fidelity)``."""
+    ``cfg.attach`` > 0: ``(mesh, attach report or None, stroke fidelity)``. ``before``:
+    the stroke fidelity of ``mesh`` when known."""
     V, F = mesh[:2]
     if cfg.attach > 0 and len(F):
-        V, attach = _attached(V, F, strokes, mesh[4], cfg, anchors)
+        V, attach = _attached(V, F, strokes, mesh[4], cfg, anchors, before)
         return (V,) + tuple(mesh[1:]), attach, attach["fidelity"][int(attach["kept"])]
-    return mesh, None, _fidelity(V, F, strokes)
+    return mesh, None, _fidelity(V, F, strokes) if before is None else before
 
 
 def _polished(fit: FlowFit, f, mesh, strokes, labels, cut_boundary, cfg: FlowConfig,
@@ -360,44 +361,57 @@ def _polished(fit: FlowFit, f, mesh, strokes, labels, cut_boundary, cfg: FlowCon
     are the ones that would be returned, and a difference of a few samples is no reason
     to return the noisier field.
 
-    A surface is faired only where the choice needs it (:func:`_ceiling`): the polished
-    one not when it cannot reach the last step's extracted fidelity, the last step's not
-    when the faired polished one is within the slack of all it could reach.
+    A surface is faired only where the choice needs it (:func:`_fidelity_and_ceiling`):
+    the polished one not when it cannot reach the last step's extracted fidelity, the
+    last step's not when the faired polished one is within the slack of all it could
+    reach.
 
     Returns ``(the kept triple of _faired, {"fidelity": [last step's, polished],
     "faired": [bool, bool], "kept": bool})``: each fidelity as faired, or as extracted
     where that surface was not faired.
     """
     polished = _extract(fit.polish(f), fit.frame, strokes, labels, cut_boundary, cfg.handles)
-    last = _fidelity(mesh[0], mesh[1], strokes)        # the fairing keeps no less
-    out = [None, None]
-    if _ceiling(polished, strokes, cfg) >= last - POLISH_SLACK:
-        out[1] = _faired(polished, strokes, cfg, anchors)
-        if out[1][2] < _ceiling(mesh, strokes, cfg) - POLISH_SLACK:
-            out[0] = _faired(mesh, strokes, cfg, anchors)
+    (last, last_ceiling), (raw, ceiling) = (_fidelity_and_ceiling(m, strokes, cfg)
+                                            for m in (mesh, polished))
+    out = [None, None]                  # the fairing keeps no less than ``last``
+    if ceiling >= last - POLISH_SLACK:
+        out[1] = _faired(polished, strokes, cfg, anchors, raw)
+        if out[1][2] < last_ceiling - POLISH_SLACK:
+            out[0] = _faired(mesh, strokes, cfg, anchors, last)
     else:
-        out[0] = _faired(mesh, strokes, cfg, anchors)
-    fidelity = [last if out[0] is None else out[0][2],
-                _fidelity(polished[0], polished[1], strokes) if out[1] is None else out[1][2]]
+        out[0] = _faired(mesh, strokes, cfg, anchors, last)
+    fidelity = [last if out[0] is None else out[0][2], raw if out[1] is None else out[1][2]]
     kept = out[1] is not None and fidelity[1] >= fidelity[0] - POLISH_SLACK
     info = {"fidelity": fidelity, "faired": [o is not None for o in out], "kept": kept}
     return (out[1] if kept else out[0]), info
 
 
-def _ceiling(mesh, strokes, cfg: FlowConfig) -> float:
-    """The most stroke fidelity that ``mesh`` (:func:`_extract`'s tuple) can have after
-    :func:`_faired`: its own without the fairing; with it, the share of stroke length
-    within the pull's reach (``cfg.attach_reach`` cells) plus :data:`_BEYOND_REACH`."""
-    V, F = mesh[:2]
-    if cfg.attach > 0 and len(F):
-        return min(1.0, _fidelity(V, F, strokes, cfg.attach_reach * mesh[4]) + _BEYOND_REACH)
-    return _fidelity(V, F, strokes)
+def _fidelity_and_ceiling(mesh, strokes, cfg: FlowConfig) -> tuple[float, float]:
+    """The stroke fidelity of ``mesh`` (:func:`_extract`'s tuple) and the most it can have
+    after :func:`_faired`: the same without the fairing; with it, the share of stroke
+    length within the pull's reach (``cfg.attach_reach`` cells) plus
+    :data:`_BEYOND_REACH`. One distance from each stroke sample to the mesh serves both
+    (0, 0 when the mesh has no triangle of positive area)."""
+    from curvenet.core.errors import InvalidParameterError
+    from curvenet.core.fidelity import (FIDELITY_TOL_REL, STROKE_SPACING_REL,
+                                        stroke_sample_distances)
+    try:
+        d, diag = stroke_sample_distances(mesh[:2], strokes, STROKE_SPACING_REL)[:2]
+    except InvalidParameterError:          # no faces, or only degenerate ones
+        return 0.0, 0.0
+    fidelity = float(np.mean(d / diag < FIDELITY_TOL_REL))
+    if cfg.attach > 0:
+        within = min(cfg.attach_reach * mesh[4] / diag, 0.99)
+        return fidelity, min(1.0, float(np.mean(d / diag < within)) + _BEYOND_REACH)
+    return fidelity, fidelity
 
 
-def _attached(V, F, strokes, h_world, cfg: FlowConfig, anchors=None):
+def _attached(V, F, strokes, h_world, cfg: FlowConfig, anchors=None,
+              before: float | None = None):
     """The mesh faired onto its strokes (:func:`neural.attach.attach_to_strokes`) if it
     holds at least as much of them; ``(V, {"fidelity": [before, after], "kept": bool,
-    "samples", "pulled", "held"})``.
+    "samples", "pulled", "held"})``. ``before``: the stroke fidelity of ``(V, F)`` when
+    known.
 
     ``anchors`` ((m, 3) float64, a hybrid fill's anchor points) pull like stroke samples,
     and nothing is held to the band: a fill's strokes are the loose strokes no patch
@@ -409,21 +423,18 @@ def _attached(V, F, strokes, h_world, cfg: FlowConfig, anchors=None):
                                weight=cfg.attach_weight, band=band, reach=cfg.attach_reach,
                                normals=cfg.attach_normals,
                                points=anchors)
-    fidelity = [_fidelity(V, F, strokes), _fidelity(X, F, strokes)]
+    fidelity = [_fidelity(V, F, strokes) if before is None else before,
+                _fidelity(X, F, strokes)]
     kept = bool(np.isfinite(X).all() and fidelity[1] >= fidelity[0])
     return (X if kept else V), dict(rep, fidelity=fidelity, kept=kept)
 
 
-def _fidelity(V, F, strokes, within: float | None = None) -> float:
-    """Stroke fidelity of the mesh ``(V, F)`` (0 when it has no triangle of positive area);
-    with ``within`` (model units), the share of stroke length within that distance of it
-    instead of the fidelity's tolerance."""
+def _fidelity(V, F, strokes) -> float:
+    """Stroke fidelity of the mesh ``(V, F)`` (0 when it has no triangle of positive area)."""
     from curvenet.core.errors import InvalidParameterError
-    from curvenet.core.fidelity import FIDELITY_TOL_REL, sketch_fidelity
-    tol = FIDELITY_TOL_REL if within is None else min(within / bbox_diagonal(list(strokes)),
-                                                      0.99)
+    from curvenet.core.fidelity import sketch_fidelity
     try:
-        return sketch_fidelity((V, F), strokes, tol=tol)["surface"]
+        return sketch_fidelity((V, F), strokes)["surface"]
     except InvalidParameterError:          # no faces, or only degenerate ones
         return 0.0
 

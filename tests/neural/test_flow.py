@@ -266,7 +266,7 @@ def test_polish_may_hold_a_little_less_of_the_strokes(monkeypatch, polished, kep
     last = ("last", np.array([[0, 1, 2]]), None, None, 0.1)
     mesh = ("polished",) + last[1:]
     monkeypatch.setattr(flow, "_extract", lambda *a: mesh)
-    monkeypatch.setattr(flow, "_fidelity", lambda *a: 1.0)    # as extracted, and in reach
+    monkeypatch.setattr(flow, "_fidelity_and_ceiling", lambda *a: (1.0, 1.0))   # all in reach
     monkeypatch.setattr(flow, "_faired", lambda m, *a: (m, None, polished if m is mesh
                                                         else 1.0))
     chosen, info = flow._polished(_PolishFit(1.0), None, last, [], [], True,
