@@ -20,7 +20,12 @@ cotangent Laplacian and ``M`` the Voronoi mass matrix of the extracted mesh ``V`
    + sum_s beta_s |B_s X - t_s|^2``, with ``B_s`` the barycentric row of the closest
    surface point of each stroke sample ``s`` within ``reach`` grid cells of ``V`` and
    ``alpha_2`` the same low-pass at :data:`SPREAD` times the cutoff: the displacement
-   that brings the surface onto its strokes is smoother than the shape itself.
+   that brings the surface onto its strokes is smoother than the shape itself. Where
+   the shape is wide, this cutoff grows up to :data:`FLAT` times more, per vertex, but
+   never past the circumference ``pi / |H|`` of the cylinder of the shape's mean
+   curvature ``H`` (``|M^-1 L Y| / 2``, averaged over the filter's reach): across a
+   tube thinner than the cutoff the pulls on either side differ, and a displacement
+   smoother than the tube cannot follow them (it pulls the tube in).
 
 Done in one step (the pull added to the first energy, as this module first did), the
 pull of each stroke sample dents the surface within the first low-pass's reach, about
@@ -29,7 +34,8 @@ a seam of small dents along every stroke. Spread over twice the cutoff, the same
 bends the surface over a wider area and leaves no dent.
 
 Every sample first pulls with ``beta = weight alpha_2 h^2`` (a stroke sample every cell
-weighs ``weight`` times a vertex's area term of step 2) towards itself (``t_s = s``). The
+weighs ``weight`` times a vertex's area term of step 2, ``alpha_2`` taken at the pulled
+point) towards itself (``t_s = s``). The
 weaker that data term (the longer the cutoff), the weaker the pull: a low-pass long
 enough to take out every lump would also let the surface sag off its strokes. So with
 a ``band``, the samples the solution leaves farther than ``band`` from the surface are
@@ -72,13 +78,16 @@ from scipy.spatial import cKDTree
 from curvenet.core.geometry import face_normals_areas
 from curvenet.core.tolerances import DIVISION_GUARD
 
-__all__ = ["attach_to_strokes", "fill_order", "normal_faired", "HELD", "NORMAL_ROUNDS", "SPREAD",
-           "TRUSTED"]
+__all__ = ["attach_to_strokes", "fill_order", "normal_faired", "FLAT", "HELD", "NORMAL_ROUNDS",
+           "SPREAD", "TRUSTED"]
 
 #: How much harder a stroke sample outside the band pulls than the others.
 HELD = 1000.0
 #: The displacement onto the strokes is low-passed at this many times the shape's cutoff.
 SPREAD = 2.0
+#: Where the surface is flat enough, the displacement's cutoff grows up to this many times
+#: its value (see step 2 of the module notes).
+FLAT = 2.0
 #: Solves after the first, each holding the samples still outside the band.
 _HOLD_ROUNDS = 2
 #: Vertex-update rounds of step 0 per cell of its cutoff: a round moves a vertex by what
@@ -143,7 +152,8 @@ def _solve(A, rhs, order: np.ndarray) -> np.ndarray:
 
 
 def _operators(V, F):
-    """The bi-Laplacian ``L^T M^-1 L`` (n, n) sparse and Voronoi areas ``m`` (n,) of ``(V, F)``."""
+    """The cotangent Laplacian ``L`` (n, n) sparse, the bi-Laplacian ``L^T M^-1 L`` (n, n)
+    sparse and the Voronoi areas ``m`` (n,) of ``(V, F)``."""
     import igl
     n = len(V)
     L = sp.csr_matrix(igl.cotmatrix(V, F))
@@ -152,7 +162,23 @@ def _operators(V, F):
     md = igl.massmatrix(V, F, igl.MASSMATRIX_TYPE_VORONOI).diagonal()
     m[:len(md)] = md
     m = np.maximum(m, 1e-12 * m.max())
-    return L.T @ sp.diags(1.0 / m) @ L, m
+    return L, L.T @ sp.diags(1.0 / m) @ L, m
+
+
+def _mean_curvature(L, Y, m: np.ndarray, F, reach: float) -> np.ndarray:
+    """|H| (n,) float64 of the smooth surface ``Y`` (n, 3): half the length of ``M^-1 L Y``
+    (``L`` and the areas ``m`` of a mesh with ``Y``'s connectivity and nearly its
+    shape), averaged over ``reach`` edges (``reach^2`` rounds of one-ring means, a
+    diffusion of that radius)."""
+    n = len(Y)
+    H = 0.5 * np.linalg.norm(L @ Y, axis=1) / m
+    e = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
+    ring = sp.csr_matrix((np.ones(len(e)), (e[:, 0], e[:, 1])), shape=(n, n))
+    ring = ((ring + ring.T) > 0).astype(np.float64) + sp.identity(n, format="csr")
+    deg = np.asarray(ring.sum(axis=1)).ravel()
+    for _ in range(int(np.ceil(reach * reach))):
+        H = (ring @ H) / deg
+    return H
 
 
 def _unit_rows(x: np.ndarray) -> np.ndarray:
@@ -170,7 +196,7 @@ def normal_faired(V, F, h: float, cutoff: float, order=None) -> np.ndarray:
     n = len(V)
     if order is None:
         order = fill_order(F, n)
-    bend, m = _operators(V, F)
+    bend, m = _operators(V, F)[1:]
     alpha = (2.0 * np.pi / (cutoff * h)) ** 4 * m
     fn, area = face_normals_areas(V, F)
     inc = sp.csr_matrix((np.ones(3 * len(F)), (F.ravel(), np.repeat(np.arange(len(F)), 3))),
@@ -250,7 +276,7 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
         F = drop_degenerate(V, F)[0]               # a triangle the update flattened
         if not len(F):
             return V, {"samples": 0, "pulled": 0, "held": 0}
-    bend, m = _operators(V, F)
+    L, bend, m = _operators(V, F)
     S = np.concatenate(([densify_polylines(strokes, h)[0]] if len(strokes) else [])
                        + ([] if points is None else [np.asarray(points, np.float64)]))
     near = np.sqrt(np.maximum(igl.point_mesh_squared_distance(S, V, F)[0], 0.0)) < reach * h
@@ -265,10 +291,15 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
         return Y, {"samples": int(len(near)), "pulled": int(len(S)), "held": 0}
     d2, fi, closest = igl.point_mesh_squared_distance(S, Y, F)
     dist = np.sqrt(np.maximum(d2, 0.0))
-    alpha2 = (2.0 * np.pi / (SPREAD * cutoff * h)) ** 4                  # step 2: onto the strokes
-    K = bend + alpha2 * sp.diags(m)
+    # step 2, onto the strokes: the displacement's cutoff, SPREAD times the shape's, grows
+    # up to FLAT times more but stays within the circumference pi / (|H| h) cells of the
+    # cylinder of the shape's mean curvature, across which the pulls may differ
+    H = _mean_curvature(L, Y, m, F, cutoff / (2.0 * np.pi))
+    c2 = SPREAD * cutoff * np.clip(np.pi / (SPREAD * cutoff * h * np.maximum(H, 1e-300)),
+                                   1.0, FLAT)
+    alpha2 = (2.0 * np.pi / (c2 * h)) ** 4                                # (n,)
+    K = bend + sp.diags(alpha2 * m)
     base = K @ Y                                   # |L (X - Y)|^2 + alpha_2 |X - Y|^2
-    beta = weight * alpha2 * h * h
     X, held = Y, np.zeros(len(S), bool)
     for r in range(1 + (_HOLD_ROUNDS if band > 0 else 0)):
         if r:   # the samples the last solve left outside the band join the held ones
@@ -285,6 +316,7 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
         # each held sample pulls to the point within `band` of it on the way to the surface
         frac = np.where(held, np.minimum(dist, band) / np.maximum(dist, 1e-300), 0.0)
         target = S + frac[:, None] * (closest - S)
+        beta = weight * h * h * (B @ alpha2)          # against the area term where it pulls
         w = np.where(held, HELD * beta, beta)
         X = _solve(K + B.T @ sp.diags(w) @ B, base + B.T @ (w[:, None] * target), order)
     return X, {"samples": int(len(near)), "pulled": int(len(S)), "held": int(held.sum())}

@@ -191,7 +191,8 @@ class FlowConfig:
         After the extraction (and the polish), fair the mesh and pull it onto the
         strokes near it (:func:`neural.attach.attach_to_strokes`): ripples shorter
         than this many grid cells are removed next to the strokes, and up to twice as
-        long away from them; 0 keeps the mesh as extracted. The
+        long away from them (the displacement onto the strokes at twice that, up to
+        four times where the surface is wide); 0 keeps the mesh as extracted. The
         result is returned only when its stroke fidelity is at least the extracted
         mesh's; ``report["attach"]`` gives both. With ``anchors`` (hybrid fills) their
         points pull too and nothing is held to ``attach_band``. Not in the paper.
