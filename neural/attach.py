@@ -123,9 +123,7 @@ def fill_order(F, n: int) -> np.ndarray:
     the two-ring neighbours on either side coupled: many times the fill).
     """
     import pymetis
-    e = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
-    ring = sp.csr_matrix((np.ones(len(e), np.int32), (e[:, 0], e[:, 1])), shape=(n, n))
-    ring = ring + ring.T
+    ring = _one_ring(F, n)
     two = (ring @ ring + ring).tocsr()
     two.setdiag(0)
     two.eliminate_zeros()
@@ -133,6 +131,14 @@ def fill_order(F, n: int) -> np.ndarray:
         return np.arange(n)
     adj = pymetis.CSRAdjacency(two.indptr.astype(np.int64), two.indices.astype(np.int64))
     return np.asarray(pymetis.nested_dissection(adjacency=adj)[0], np.int64)
+
+
+def _one_ring(F, n: int):
+    """The vertex adjacency (n, n) sparse float64 of the faces ``F`` (m, 3): 1 between the
+    two ends of each edge, 0 elsewhere (the diagonal too)."""
+    e = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
+    ring = sp.csr_matrix((np.ones(len(e)), (e[:, 0], e[:, 1])), shape=(n, n))
+    return ((ring + ring.T) > 0).astype(np.float64)
 
 
 def _factor(A, order: np.ndarray):
@@ -172,9 +178,7 @@ def _mean_curvature(L, Y, m: np.ndarray, F, reach: float) -> np.ndarray:
     diffusion of that radius)."""
     n = len(Y)
     H = 0.5 * np.linalg.norm(L @ Y, axis=1) / m
-    e = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
-    ring = sp.csr_matrix((np.ones(len(e)), (e[:, 0], e[:, 1])), shape=(n, n))
-    ring = ((ring + ring.T) > 0).astype(np.float64) + sp.identity(n, format="csr")
+    ring = _one_ring(F, n) + sp.identity(n, format="csr")
     deg = np.asarray(ring.sum(axis=1)).ravel()
     for _ in range(int(np.ceil(reach * reach))):
         H = (ring @ H) / deg
@@ -295,8 +299,7 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
     # up to FLAT times more but stays within the circumference pi / (|H| h) cells of the
     # cylinder of the shape's mean curvature, across which the pulls may differ
     H = _mean_curvature(L, Y, m, F, cutoff / (2.0 * np.pi))
-    c2 = SPREAD * cutoff * np.clip(np.pi / (SPREAD * cutoff * h * np.maximum(H, 1e-300)),
-                                   1.0, FLAT)
+    c2 = np.clip(np.pi / (h * np.maximum(H, 1e-300)), SPREAD * cutoff, FLAT * SPREAD * cutoff)
     alpha2 = (2.0 * np.pi / (c2 * h)) ** 4                                # (n,)
     K = bend + sp.diags(alpha2 * m)
     base = K @ Y                                   # |L (X - Y)|^2 + alpha_2 |X - Y|^2
