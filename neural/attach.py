@@ -20,12 +20,15 @@ cotangent Laplacian and ``M`` the Voronoi mass matrix of the extracted mesh ``V`
    + sum_s beta_s |B_s X - t_s|^2``, with ``B_s`` the barycentric row of the closest
    surface point of each stroke sample ``s`` within ``reach`` grid cells of ``V`` and
    ``alpha_2`` the same low-pass at :data:`SPREAD` times the cutoff: the displacement
-   that brings the surface onto its strokes is smoother than the shape itself. Where
-   the shape is wide, this cutoff grows up to :data:`FLAT` times more, per vertex, but
-   never past the circumference ``pi / |H|`` of the cylinder of the shape's mean
-   curvature ``H`` (``|M^-1 L Y| / 2``, averaged over the filter's reach): across a
-   tube thinner than the cutoff the pulls on either side differ, and a displacement
-   smoother than the tube cannot follow them (it pulls the tube in).
+   that brings the surface onto its strokes is smoother than the shape itself. With a
+   ``band`` (below), where the shape is wide, this cutoff grows up to :data:`FLAT`
+   times more, per vertex, but never past the circumference ``pi / |H|`` of the
+   cylinder of the shape's mean curvature ``H`` (``|M^-1 L Y| / 2``, averaged over the
+   filter's reach): across a tube thinner than the cutoff the pulls on either side
+   differ, and a displacement smoother than the tube cannot follow them (it pulls the
+   tube in). The longer cutoff weakens the pull (``beta`` below) with the area term;
+   the band's hold brings back the samples it lets go farther than the band, and
+   without a band nothing would (a hybrid fill's exact anchors).
 
 Done in one step (the pull added to the first energy, as this module first did), the
 pull of each stroke sample dents the surface within the first low-pass's reach, about
@@ -296,10 +299,12 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
     d2, fi, closest = igl.point_mesh_squared_distance(S, Y, F)
     dist = np.sqrt(np.maximum(d2, 0.0))
     # step 2, onto the strokes: the displacement's cutoff, SPREAD times the shape's, grows
-    # up to FLAT times more but stays within the circumference pi / (|H| h) cells of the
-    # cylinder of the shape's mean curvature, across which the pulls may differ
+    # (with a band) up to FLAT times more but stays within the circumference
+    # pi / (|H| h) cells of the cylinder of the shape's mean curvature, across which the
+    # pulls may differ
     H = _mean_curvature(L, Y, m, F, cutoff / (2.0 * np.pi))
-    c2 = np.clip(np.pi / (h * np.maximum(H, 1e-300)), SPREAD * cutoff, FLAT * SPREAD * cutoff)
+    c2 = np.clip(np.pi / (h * np.maximum(H, 1e-300)), SPREAD * cutoff,
+                 (FLAT if band > 0 else 1.0) * SPREAD * cutoff)
     alpha2 = (2.0 * np.pi / (c2 * h)) ** 4                                # (n,)
     K = bend + sp.diags(alpha2 * m)
     base = K @ Y                                   # |L (X - Y)|^2 + alpha_2 |X - Y|^2
