@@ -140,7 +140,7 @@ def _sphere_inside_its_strokes():
 
 def test_the_mean_curvature_of_a_sphere_is_one_over_its_radius():
     from curvenet.core.distance import drop_degenerate
-    V, F, _, h = _sphere_inside_its_strokes()
+    V, F = _sphere_inside_its_strokes()[:2]
     for radius in (1.0, 2.5):
         P = radius * V
         G = drop_degenerate(P, F)[0]
@@ -151,12 +151,12 @@ def test_the_mean_curvature_of_a_sphere_is_one_over_its_radius():
 
 
 def test_where_the_surface_is_wide_the_pull_spreads_further(monkeypatch):
-    """On :func:`_sphere_inside_its_strokes` (the circumference of its mean curvature,
-    2 pi, is 66 cells) the displacement onto the strokes is low-passed at ``FLAT`` = 2
-    times its cutoff: the sphere comes out nearer its strokes between them (mean radius
-    1.020 -> 1.033 of 1.04) and the seam along them is smoother (90th percentile of the
-    roughness 2.9 -> 2.0 thousandths), the strokes held as before. On a thin tube the
-    cutoff does not grow
+    """On :func:`_sphere_inside_its_strokes` (the circumference ``pi / |H|`` of the
+    cylinder of its mean curvature is pi, 66 cells) the displacement onto the strokes is
+    low-passed at 40 cells, ``FLAT`` = 2 times its 20 (twice the cutoff): the sphere
+    comes out nearer its strokes between them (mean radius 1.020 -> 1.033 of 1.04) and
+    the seam along them is smoother (90th percentile of the roughness 2.9 -> 2.0
+    thousandths), the strokes held as before. On a thin tube the cutoff does not grow
     (:func:`test_the_default_fairing_does_not_shrink_a_thin_tube_between_its_strokes`),
     nor without a band, which would not bring back what the weaker pull lets go."""
     import igl
