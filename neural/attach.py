@@ -302,9 +302,10 @@ def attach_to_strokes(V, F, strokes, h: float, *, cutoff: float, weight: float,
     # (with a band) up to FLAT times more but stays within the circumference
     # pi / (|H| h) cells of the cylinder of the shape's mean curvature, across which the
     # pulls may differ
-    H = _mean_curvature(L, Y, m, F, cutoff / (2.0 * np.pi))
-    c2 = np.clip(np.pi / (h * np.maximum(H, 1e-300)), SPREAD * cutoff,
-                 (FLAT if band > 0 else 1.0) * SPREAD * cutoff)
+    c2 = np.full(len(V), SPREAD * cutoff)
+    if band > 0 and FLAT > 1:
+        H = _mean_curvature(L, Y, m, F, cutoff / (2.0 * np.pi))
+        c2 = np.clip(np.pi / (h * np.maximum(H, 1e-300)), c2, FLAT * c2)
     alpha2 = (2.0 * np.pi / (c2 * h)) ** 4                                # (n,)
     K = bend + sp.diags(alpha2 * m)
     base = K @ Y                                   # |L (X - Y)|^2 + alpha_2 |X - Y|^2
