@@ -392,17 +392,14 @@ def _fidelity_and_ceiling(mesh, strokes, cfg: FlowConfig) -> tuple[float, float]
     length within the pull's reach (``cfg.attach_reach`` cells) plus
     :data:`_BEYOND_REACH`. One distance from each stroke sample to the mesh serves both
     (0, 0 when the mesh has no triangle of positive area)."""
-    from curvenet.core.errors import InvalidParameterError
-    from curvenet.core.fidelity import (FIDELITY_TOL_REL, STROKE_SPACING_REL,
-                                        stroke_sample_distances)
-    try:
-        d, diag = stroke_sample_distances(mesh[:2], strokes, STROKE_SPACING_REL)[:2]
-    except InvalidParameterError:          # no faces, or only degenerate ones
+    from curvenet.core.fidelity import FIDELITY_TOL_REL
+    d, diag = _stroke_distances(*mesh[:2], strokes)
+    if d is None:
         return 0.0, 0.0
-    fidelity = float(np.mean(d / diag < FIDELITY_TOL_REL))
+    fidelity = float(np.mean(d < FIDELITY_TOL_REL))
     if cfg.attach > 0:
         within = min(cfg.attach_reach * mesh[4] / diag, 0.99)
-        return fidelity, min(1.0, float(np.mean(d / diag < within)) + _BEYOND_REACH)
+        return fidelity, min(1.0, float(np.mean(d < within)) + _BEYOND_REACH)
     return fidelity, fidelity
 
 
@@ -430,13 +427,25 @@ def _attached(V, F, strokes, h_world, cfg: FlowConfig, anchors=None,
 
 
 def _fidelity(V, F, strokes) -> float:
-    """Stroke fidelity of the mesh ``(V, F)`` (0 when it has no triangle of positive area)."""
+    """Stroke fidelity of the mesh ``(V, F)`` (:func:`curvenet.core.fidelity.sketch_fidelity`'s
+    ``surface``; 0 when it has no triangle of positive area)."""
+    from curvenet.core.fidelity import FIDELITY_TOL_REL
+    d = _stroke_distances(V, F, strokes)[0]
+    return 0.0 if d is None else float(np.mean(d < FIDELITY_TOL_REL))
+
+
+def _stroke_distances(V, F, strokes):
+    """``(d, diag)``: the distance (k,) float64 of each stroke sample of the fidelity
+    (:func:`curvenet.core.fidelity.stroke_sample_distances`) to the mesh ``(V, F)``
+    divided by the sketch's diagonal ``diag``; ``(None, None)`` when the mesh has no
+    triangle of positive area."""
     from curvenet.core.errors import InvalidParameterError
-    from curvenet.core.fidelity import sketch_fidelity
+    from curvenet.core.fidelity import STROKE_SPACING_REL, stroke_sample_distances
     try:
-        return sketch_fidelity((V, F), strokes)["surface"]
+        d, diag = stroke_sample_distances((V, F), strokes, STROKE_SPACING_REL)[:2]
     except InvalidParameterError:          # no faces, or only degenerate ones
-        return 0.0
+        return None, None
+    return d / diag, diag
 
 
 def _extract(f_final, frame: Frame, strokes, labels, cut_boundary, handles: int = 0):
