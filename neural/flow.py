@@ -91,8 +91,9 @@ Engineering choices (documented deviations / gap fills)
   holding each of them drags thin sheets of the fill onto the strays (spikes).
 * ``handles`` (default): before the extraction, the small holes and thin strands that
   the Monte-Carlo noise of f leaves in its zero set (each a handle of the surface, a
-  pit or a tear once faired) are plugged and cut on the grid, the rest of the zero
-  set unmoved (:func:`neural.topology.remove_small_handles`).
+  pit or a tear once faired) are plugged and cut on the grid, after the specks of
+  solid that no stroke passes through, the rest of the zero set unmoved
+  (:func:`neural.topology.remove_small_handles`).
 * ``subdivide`` (draft, default): the final mesh is subdivided once, its new vertices
   on the curved point-normal triangles of the old ones
   (:func:`curvenet.core.geometry.subdivide_curved`): the facets of a mesh extracted
@@ -118,7 +119,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from curvenet.core.geometry import bbox_diagonal, subdivide_curved
+from curvenet.core.geometry import bbox_diagonal, densify_polylines, subdivide_curved
 from curvenet.core.result import MeshResult
 from curvenet.core.strokes import check_strokes
 from curvenet.core.tolerances import NORM_EPS
@@ -463,11 +464,12 @@ def _extract(f_final, frame: Frame, strokes, labels, cut_boundary, handles: int 
     f_np = f_final.detach().to("cpu", torch.float32).numpy()
     if f_np[0, 0, 0] < 0:        # the box corner is outside: make f > 0 outside
         f_np = -f_np
-    if handles > 1:
-        from .topology import remove_small_handles
-        f_np = remove_small_handles(f_np, handles)[0]
     h_world = frame.side / f_np.shape[0]
     origin = frame.box_min + 0.5 * h_world
+    if handles > 1:
+        from .topology import remove_small_handles
+        f_np = remove_small_handles(f_np, handles, _stroke_voxels(strokes, origin, h_world,
+                                                                  f_np.shape))[0]
     V, F = marching_cubes_world(f_np, origin, h_world)
     V, F = keep_supported_components(V, F, strokes, 4.0 * h_world, LONE_NODE_AREA * h_world ** 2)
     n_before_cut = len(F)
@@ -476,3 +478,17 @@ def _extract(f_final, frame: Frame, strokes, labels, cut_boundary, handles: int 
                                   [s for s, lab in zip(strokes, labels) if lab != "boundary"],
                                   1.5 * h_world)
     return V, F, f_np, origin, h_world, n_before_cut - len(F)
+
+
+def _stroke_voxels(strokes, origin, h: float, shape) -> np.ndarray:
+    """The grid nodes (``shape`` bool) within one node of a stroke: the 3 x 3 x 3 block
+    around the node nearest each stroke sample (half a cell apart). Node ``(i, j, k)``
+    lies at ``origin + (i, j, k) * h``."""
+    keep = np.zeros(shape, bool)
+    if not len(strokes):
+        return keep
+    ijk = np.rint((densify_polylines(strokes, h / 2.0)[0] - origin) / h).astype(np.int64)
+    block = np.stack(np.meshgrid(*[[-1, 0, 1]] * 3, indexing="ij"), axis=-1).reshape(-1, 3)
+    ijk = np.clip((ijk[:, None, :] + block).reshape(-1, 3), 0, np.asarray(shape) - 1)
+    keep[tuple(ijk.T)] = True
+    return keep

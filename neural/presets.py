@@ -213,8 +213,9 @@ class FlowConfig:
         not done. Not in the paper.
     handles : int
         Before the extraction, the holes and strands of f's zero set up to ``handles -
-        1`` grid cells across that make handles of the surface are plugged and cut, the
-        rest of the zero set unmoved (:func:`neural.topology.remove_small_handles`;
+        1`` grid cells across that make handles of the surface are plugged and cut, and
+        the specks of solid smaller than that cube that no stroke passes through
+        dropped, the rest of the zero set unmoved (:func:`neural.topology.remove_small_handles`;
         odd, 0 = not done). 5 at ``default``, whose extracted surfaces of genus-0
         sketches otherwise carry up to tens of such handles; not in ``draft``, whose
         cells are twice as large. Not in the paper.

@@ -10,6 +10,12 @@ fairing (:mod:`neural.attach`) a small handle is a pit or a see-through tear.
 spirit of Wood et al. (2004): a handle is removed only if it is small, and the rest of
 the zero set does not move. With the solid ``I = {f < 0}``:
 
+0. **specks**: the pieces of ``I`` smaller than the largest closing cube (fewer voxels)
+   that no stroke passes through (``keep``) are given to the air. They are noise of f,
+   which :func:`neural.extract.keep_supported_components` would drop after the
+   extraction anyway (or keep as specks beside the surface), and a speck inside a
+   small hole makes its plug join two pieces of the solid, which step 1 refuses (below):
+   on the crumpled sheet of the vns doghead's neck, most of the handles left;
 1. **plugs**: the closing of ``I`` by a cube of ``size`` cells fills every hole and gap
    narrower than the cube. It also fills wide gaps' narrow ends and fattens concave
    corners, so the filled voxels are then given back to the outside one at a time as
@@ -21,7 +27,7 @@ the zero set does not move. With the solid ``I = {f < 0}``:
    strand of solid that forms a loop at one voxel.
 
 Pockets of one side that the closing would swallow whole (a cavity in the solid, a
-speck of solid in the air) are left alone: they are no handle, and a thin pocket may be
+speck of solid that step 0 keeps) are left alone: they are no handle, and a thin pocket may be
 what holds a stroke. A plug that would join two pieces of the solid, and a cut that
 would open a cavity or split a piece of the solid in two (a thin neck, a speck apart),
 joins or parts what was not a handle, and is left out too. A plug may seal a pocket of
@@ -184,7 +190,7 @@ def _close_small(f: np.ndarray, size: int, kept: np.ndarray, may_split: bool) ->
     return plug & ~np.isin(plugs, np.flatnonzero(bad))
 
 
-def remove_small_handles(f, size: int = 5) -> tuple[np.ndarray, dict]:
+def remove_small_handles(f, size: int = 5, keep=None) -> tuple[np.ndarray, dict]:
     """``f`` with the small handles of its zero set plugged and cut (see the notes).
 
     Parameters
@@ -194,25 +200,36 @@ def remove_small_handles(f, size: int = 5) -> tuple[np.ndarray, dict]:
     size : int
         Odd width (cells) of the largest closing cube: holes and strands up to
         ``size - 1`` cells across are taken out; 0 or 1 changes nothing.
+    keep : (a, b, c) bool array, optional
+        The voxels a stroke passes through: a speck of solid that holds one stays
+        (step 0 of the notes). None: no speck is dropped.
 
     Returns
     -------
     f : (a, b, c) float array, the same dtype
-        A new array, equal to ``f`` except at the plugged and cut voxels.
+        A new array, equal to ``f`` except at the dropped, plugged and cut voxels.
     report : dict
-        ``plugged``, ``cut``: voxels moved into the solid and out of it.
+        ``specks``: voxels of the dropped specks; ``plugged``, ``cut``: voxels moved
+        into the solid and out of it by the plugs and cuts.
 
     Raises
     ------
     ValueError
-        ``size`` negative or even (other than 0).
+        ``size`` negative or even (other than 0), or ``keep`` not of ``f``'s shape.
     """
     if int(size) != size or size < 0 or (size > 1 and size % 2 == 0):
         raise ValueError(f"size must be 0, 1 or an odd integer >= 3, got {size!r}")
+    if keep is not None and np.shape(keep) != np.shape(f):
+        raise ValueError(f"keep has shape {np.shape(keep)}, f {np.shape(f)}")
     out = np.array(f)
+    count = {"specks": 0, "plugged": 0, "cut": 0}
+    if size < 3 or not (out < 0).any() or (out < 0).all():
+        return out, count
+    if keep is not None:
+        count["specks"] = _drop_specks(out, int(size) ** 3, np.asarray(keep, bool))
     inside = out < 0
-    if size < 3 or not inside.any() or inside.all():
-        return out, {"plugged": 0, "cut": 0}
+    if not inside.any():
+        return out, count
     # nothing changes farther than the cube from the solid: work in its box, with air
     # all round it (one outside, as in the whole grid)
     solid = np.argwhere(inside)
@@ -221,9 +238,8 @@ def remove_small_handles(f, size: int = 5) -> tuple[np.ndarray, dict]:
     box = tuple(slice(a, b) for a, b in zip(lo, hi))
     f = out[box]
     moved = np.zeros(f.shape, bool)      # what no later step may undo
-    count = {1: 0, -1: 0}                # plugged, cut
     for s in range(3, int(size) + 1, 2):
-        for sign in (1, -1):
+        for sign, what in ((1, "plugged"), (-1, "cut")):
             g = sign * f
             plug = _close_small(g, s, moved, may_split=sign > 0)
             if plug.any():
@@ -231,6 +247,21 @@ def remove_small_handles(f, size: int = 5) -> tuple[np.ndarray, dict]:
                 g[plug] = -value * float(np.median(np.abs(g[g < 0])))
                 f = sign * g
                 moved |= plug
-                count[sign] += int(plug.sum())
+                count[what] += int(plug.sum())
     out[box] = f
-    return out, {"plugged": count[1], "cut": count[-1]}
+    return out, count
+
+
+def _drop_specks(f: np.ndarray, most: int, keep: np.ndarray) -> int:
+    """Give the air, in place, the pieces of the solid ``{f < 0}`` of fewer than ``most``
+    voxels that hold no ``keep`` voxel (step 0 of the notes); returns the voxels moved."""
+    pieces, n = ndimage.label(f < 0)
+    if not n:
+        return 0
+    idx = np.arange(1, n + 1)
+    speck = ((ndimage.sum_labels(np.ones_like(keep), pieces, idx) < most)
+             & (ndimage.maximum(keep, pieces, idx) == 0))
+    drop = np.isin(pieces, idx[speck])
+    if drop.any():
+        f[drop] = CUT_VALUE * float(np.median(f[f > 0]))
+    return int(drop.sum())

@@ -75,7 +75,7 @@ def test_a_hole_wider_than_the_cube_is_left_open():
     solid[16:24, 16:24, 16:24] = False                      # 8 cells across
     f = _field(solid)
     g, rep = remove_small_handles(f, 5)
-    assert rep == {"plugged": 0, "cut": 0}
+    assert rep == {"specks": 0, "plugged": 0, "cut": 0}
     np.testing.assert_array_equal(g, f)
     assert _euler(g) == 0
 
@@ -97,7 +97,7 @@ def test_a_thin_neck_between_two_blocks_is_not_cut():
     f = _field(solid)
     g, rep = remove_small_handles(f, 5)
     np.testing.assert_array_equal(g, f)
-    assert rep == {"plugged": 0, "cut": 0} and ndimage.label(g < 0)[1] == 1
+    assert rep == {"specks": 0, "plugged": 0, "cut": 0} and ndimage.label(g < 0)[1] == 1
 
 
 def test_a_thin_cavity_and_a_narrow_gap_are_kept():
@@ -127,3 +127,33 @@ def test_the_default_preset_takes_out_handles_and_the_others_do_not():
     assert get_config("draft").handles == get_config("paper").handles == 0
     with pytest.raises(ValueError, match="handles"):
         get_config("default", handles=4)
+
+
+def test_a_speck_in_a_small_hole_is_dropped_unless_a_stroke_passes_through_it():
+    solid = _slab()
+    solid[18:22, 18:22, 16:24] = False                      # a 4 x 4 hole
+    solid[19:21, 19:21, 19:21] = True                       # a speck of 8 voxels in it
+    f = _field(solid)
+    # the speck and the slab are two pieces, and a plug may not join them: the hole stays
+    g, rep = remove_small_handles(f, 5)
+    assert rep["plugged"] == 0 and ndimage.label(g < 0)[1] == 2
+    assert _euler(g) == 0 + 2                               # the slab's handle, the speck
+    g, rep = remove_small_handles(f, 5, np.zeros(f.shape, bool))
+    assert rep["specks"] == 8 and rep["plugged"] >= 1
+    assert ndimage.label(g < 0)[1] == 1 and _euler(g) == 2
+    keep = np.zeros(f.shape, bool)
+    keep[20, 20, 20] = True                                 # a stroke through the speck
+    g, rep = remove_small_handles(f, 5, keep)
+    assert rep["specks"] == 0 and ndimage.label(g < 0)[1] == 2
+    with pytest.raises(ValueError, match="keep"):
+        remove_small_handles(f, 5, keep[:-1])
+
+
+def test_the_stroke_voxels_are_the_nodes_next_to_a_stroke():
+    from neural.flow import _stroke_voxels
+    stroke = np.array([[2.0, 5.0, 5.0], [8.0, 5.0, 5.0]])   # along x through node row (., 5, 5)
+    keep = _stroke_voxels([stroke], np.zeros(3), 1.0, (12, 12, 12))
+    want = np.zeros((12, 12, 12), bool)
+    want[1:10, 4:7, 4:7] = True
+    np.testing.assert_array_equal(keep, want)
+    assert not _stroke_voxels([], np.zeros(3), 1.0, (4, 4, 4)).any()
