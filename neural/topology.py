@@ -15,7 +15,7 @@ the zero set does not move. With the solid ``I = {f < 0}``:
    which :func:`neural.extract.keep_supported_components` would drop after the
    extraction anyway (or keep as specks beside the surface), and a speck inside a
    small hole makes its plug join two pieces of the solid, which step 1 refuses (below):
-   on the crumpled sheet of the vns doghead's neck, most of the handles left;
+   where many strokes cross, f's crumpled sheet holds many such specks;
 1. **plugs**: the closing of ``I`` by a cube of ``size`` cells fills every hole and gap
    narrower than the cube. It also fills wide gaps' narrow ends and fattens concave
    corners, so the filled voxels are then given back to the outside one at a time as
