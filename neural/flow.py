@@ -119,13 +119,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from curvenet.core.geometry import bbox_diagonal, densify_polylines, subdivide_curved
+from curvenet.core.geometry import bbox_diagonal, subdivide_curved
 from curvenet.core.result import MeshResult
 from curvenet.core.strokes import check_strokes
 from curvenet.core.tolerances import NORM_EPS
 
 from .flowfit import FlowFit
-from .frame import Frame
+from .frame import Frame, stroke_nodes
 from .presets import FlowConfig, get_config
 from .training import torch_device, train
 
@@ -482,13 +482,7 @@ def _extract(f_final, frame: Frame, strokes, labels, cut_boundary, handles: int 
 
 def _stroke_voxels(strokes, origin, h: float, shape) -> np.ndarray:
     """The grid nodes (``shape`` bool) within one node of a stroke: the 3 x 3 x 3 block
-    around the node nearest each stroke sample (half a cell apart). Node ``(i, j, k)``
-    lies at ``origin + (i, j, k) * h``."""
-    keep = np.zeros(shape, bool)
-    if not len(strokes):
-        return keep
-    ijk = np.rint((densify_polylines(strokes, h / 2.0)[0] - origin) / h).astype(np.int64)
-    block = np.stack(np.meshgrid(*[[-1, 0, 1]] * 3, indexing="ij"), axis=-1).reshape(-1, 3)
-    ijk = np.clip((ijk[:, None, :] + block).reshape(-1, 3), 0, np.asarray(shape) - 1)
-    keep[tuple(ijk.T)] = True
-    return keep
+    around each of :func:`neural.frame.stroke_nodes` (node ``(i, j, k)`` at ``origin +
+    (i, j, k) * h``)."""
+    from scipy.ndimage import binary_dilation
+    return binary_dilation(stroke_nodes(strokes, origin, h, shape), np.ones((3, 3, 3), bool))

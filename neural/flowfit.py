@@ -15,7 +15,7 @@ import numpy as np
 from curvenet.core.geometry import face_normals_areas, sample_surface
 from curvenet.core.tolerances import COINCIDENT_REL, NORM_EPS
 
-from .frame import Frame
+from .frame import Frame, stroke_nodes
 from .presets import FlowConfig
 from .sampling import StrokeSampler, sample_surface_cells
 from .training import GLOBAL_STREAM, Stage, Step, seeded
@@ -93,13 +93,8 @@ def _smoothness_scale(strokes_unit, cfg: FlowConfig):
         return None
     from scipy.ndimage import distance_transform_edt
 
-    from curvenet.core.geometry import densify_polylines
     res = cfg.res
-    pts = densify_polylines(strokes_unit, 0.5 / res)[0]
-    ijk = np.clip(np.rint(pts * res - 0.5).astype(np.int64), 0, res - 1)
-    free = np.ones((res,) * 3, bool)
-    free[tuple(ijk.T)] = False
-    d = distance_transform_edt(free)
+    d = distance_transform_edt(~stroke_nodes(strokes_unit, 0.5 / res, 1.0 / res, (res,) * 3))
     near = cfg.smooth_near / 3.0
     t = np.clip((d - near) / (cfg.smooth_near - near), 0.0, 1.0)
     return (cfg.w_smooth_near + t * (cfg.w_smooth - cfg.w_smooth_near)) / cfg.w_smooth

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Frame"]
+__all__ = ["Frame", "stroke_nodes"]
 
 
 @dataclass
@@ -49,3 +49,15 @@ class Frame:
     def to_world(self, u):
         """Unit-cube coordinates ``(..., 3)`` -> world points ``(..., 3)`` float64."""
         return np.asarray(u, float) * self.side + self.box_min
+
+
+def stroke_nodes(strokes, origin, h: float, shape) -> np.ndarray:
+    """The grid nodes (``shape`` bool) nearest to the samples of ``strokes`` (list of (k, 3)
+    polylines) taken half a cell apart: node ``(i, j, k)`` lies at ``origin + (i, j, k) *
+    h`` (clipped to the grid)."""
+    from curvenet.core.geometry import densify_polylines
+    nodes = np.zeros(shape, bool)
+    if len(strokes):
+        ijk = np.rint((densify_polylines(strokes, h / 2.0)[0] - origin) / h).astype(np.int64)
+        nodes[tuple(np.clip(ijk, 0, np.asarray(shape) - 1).T)] = True
+    return nodes

@@ -223,13 +223,14 @@ def remove_small_handles(f, size: int = 5, keep=None) -> tuple[np.ndarray, dict]
         raise ValueError(f"keep has shape {np.shape(keep)}, f {np.shape(f)}")
     out = np.array(f)
     count = {"specks": 0, "plugged": 0, "cut": 0}
-    if size < 3 or not (out < 0).any() or (out < 0).all():
+    inside = out < 0
+    if size < 3 or not inside.any() or inside.all():
         return out, count
     if keep is not None:
         count["specks"] = _drop_specks(out, int(size) ** 3, np.asarray(keep, bool))
-    inside = out < 0
-    if not inside.any():
-        return out, count
+        inside = out < 0
+        if not inside.any():
+            return out, count
     # nothing changes farther than the cube from the solid: work in its box, with air
     # all round it (one outside, as in the whole grid)
     solid = np.argwhere(inside)
@@ -256,12 +257,10 @@ def _drop_specks(f: np.ndarray, most: int, keep: np.ndarray) -> int:
     """Give the air, in place, the pieces of the solid ``{f < 0}`` of fewer than ``most``
     voxels that hold no ``keep`` voxel (step 0 of the notes); returns the voxels moved."""
     pieces, n = ndimage.label(f < 0)
-    if not n:
-        return 0
-    idx = np.arange(1, n + 1)
-    speck = ((ndimage.sum_labels(np.ones_like(keep), pieces, idx) < most)
-             & (ndimage.maximum(keep, pieces, idx) == 0))
-    drop = np.isin(pieces, idx[speck])
+    held = np.bincount(pieces[keep], minlength=n + 1)
+    speck = (np.bincount(pieces.ravel(), minlength=n + 1) < most) & (held == 0)
+    speck[0] = False                                  # the air
+    drop = speck[pieces]
     if drop.any():
         f[drop] = CUT_VALUE * float(np.median(f[f > 0]))
     return int(drop.sum())
