@@ -24,7 +24,9 @@ heldout    ``--reference-quality`` on smooth closed sketches the presets were no
 wireframes ``--reference-quality`` and ``draft`` on clean sparse wireframes whose true surface
            is known (the curves of the network, exact, no noise): tori of 4 meridians x 2
            rings (tube radius 0.25 and 0.4) and 3 x 2 (0.4), 3 great circles of a
-           sphere, and two such spheres 0.2 apart (fitted part by part,
+           sphere, two such spheres 0.2 apart, and the edges alone of a box, an L-shaped
+           prism and a gabled house (flat faces and a notch that no stroke crosses;
+           fitted part by part,
            :mod:`neural.parts`, as the route does: ``--set split_parts=0`` for one
            field), each with the fit seeds ``--fit-seeds`` (default 0); F-score at 0.01 and
            Chamfer against the true surface
@@ -112,12 +114,13 @@ def _worker(spec: dict) -> dict:
 
 
 WIREFRAMES = ["torus r0.25 4x2", "torus r0.4 4x2", "torus r0.4 3x2", "sphere 3 circles",
-              "2 spheres gap0.2"]
+              "2 spheres gap0.2", "box edges", "l_prism edges", "house edges"]
 
 
 def _wireframe(name: str):
     """``(curves, true surface (trimesh.Trimesh))`` of a ``WIREFRAMES`` name; ``2 spheres
-    gapG``: two unit spheres of 3 great circles each, ``G`` apart."""
+    gapG``: two unit spheres of 3 great circles each, ``G`` apart; ``NAME edges``: the
+    crease curves alone of the polyhedron ``curvenet.datasets.shapes.SHAPES[NAME]``."""
     import trimesh
 
     from curvenet.datasets import sections, shapes
@@ -128,7 +131,9 @@ def _wireframe(name: str):
         sphere = ball.reference_mesh(5)
         return curves + [c + shift for c in curves], trimesh.util.concatenate(
             [sphere, sphere.copy().apply_translation(shift)])
-    if name.startswith("sphere"):
+    if name.endswith(" edges"):
+        shape = shapes.SHAPES[name.split()[0]]()
+    elif name.startswith("sphere"):
         shape = sections.great_circles(int(name.split()[1]))
     else:
         _, r, counts = name.split()
