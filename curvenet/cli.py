@@ -332,6 +332,7 @@ def _surface_one(inp: str, out: str, args) -> dict:
                 "check": res.decision.explain_check(),
                 "classical": explain_boundaries(res.diagnostics.get("classical")),
                 "fidelity": res.diagnostics.get("fidelity"),
+                "topology": res.diagnostics.get("topology"),
                 "cad": res.diagnostics.get("cad")}
     except CurvenetError as err:
         return {"input": inp, "output": out, "status": "error", "error": _naming(err, inp),
@@ -396,9 +397,10 @@ def _cmd_surface(args) -> int:
                      row.get("check"), *row.get("classical", [])]:
             if line:
                 print(line)
-        if row.get("fidelity"):
-            from .core.fidelity import format_fidelity
-            print(format_fidelity(row["fidelity"]))
+        from .evaluate import format_fidelity, format_topology
+        for key, fmt in (("fidelity", format_fidelity), ("topology", format_topology)):
+            if row.get(key):
+                print(fmt(row[key]))
         if row.get("cad"):
             from .cad.report import cad_report_lines
             print("\n".join(cad_report_lines(row["cad"])))

@@ -21,6 +21,7 @@ from .cad.export import CAD_FORMATS
 from .core.errors import CurvenetError, InvalidParameterError
 from .core.fidelity import sketch_fidelity, stroke_fidelity
 from .core.result import MeshResult
+from .evaluate.topology import surface_topology
 from .io.source import check_patches_match, load_source
 from .io.meshes import MESH_FORMATS, write_mesh, write_routed
 from .model.network import CurveNetwork
@@ -64,8 +65,10 @@ class SurfaceResult:
         ``classical``, ``neural`` ...).
     diagnostics : dict
         ``decision`` (why this route, one sentence), ``coverage``, ``unused_edges``
-        (curves no patch uses: dangling details, reported not lost), and each
-        surfacer's report under its label.
+        (curves no patch uses: dangling details, reported not lost), ``fidelity``
+        (:func:`curvenet.core.fidelity.sketch_fidelity`), ``topology``
+        (:func:`curvenet.evaluate.topology.surface_topology`: pieces, closure, boundary
+        loops, genus) and each surfacer's report under its label.
     decision : RouteDecision or None
         The route decision as data (``dataclasses.asdict`` makes it JSON).
     wires : list of (m, 3) float64
@@ -585,5 +588,6 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
     t = time.perf_counter()
     diag["fidelity"] = sketch_fidelity(mesh, ref, wires=wires)
     timings["fidelity"] = time.perf_counter() - t
+    diag["topology"] = surface_topology(mesh.vertices, mesh.faces)
     return SurfaceResult(mesh, name, sketch, net, ps, timings, diag, decision, wires,
                          face_route, routes, control_net=getattr(res, "control_net", None))

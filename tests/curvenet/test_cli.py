@@ -175,6 +175,8 @@ def test_snap_and_explain_print_the_snapping_line(tmp_path):
     fit = [x for x in r.stdout.splitlines() if x.startswith("fit: ")]
     assert len(fit) == 1 and "bending energy lsq " in fit[0] and "sweep " in fit[0]
     assert not any(x.startswith("smoothed: ") for x in r.stdout.splitlines())
+    # and the surface's topology: the box's, one closed piece of genus 0
+    assert "surface: 1 piece, closed, genus 0" in r.stdout.splitlines(), r.stdout
     # the same box drawn with per-sample jitter: its curves smoothed for the fit
     write_sketch(rough, rough_sketch(shapes.box().network, seed=0, jitter=0.002))
     r = run("surface", rough, "-o", tmp_path / "j.obj", "--method", "classical", "--explain")
