@@ -225,3 +225,27 @@ def cut_along_boundary(vertices, faces, boundary_strokes, other_strokes, band):
     band_faces = faces[band_face]
     band_back = band_faces[~removed_v[band_faces].any(1)]
     return _compact(vertices, np.vstack([sub[supported[lab]], band_back]))
+
+
+def edges_at_walls(vertices, faces, origin, spacing: float, n: int, tol: float = 1.5) -> int:
+    """Boundary edges of the mesh ``(vertices (V, 3), faces (F, 3))`` whose two ends lie
+    within ``tol`` cells of the walls of the node grid (``n`` nodes a side, node 0 at
+    ``origin``, ``spacing`` apart): where the zero set of a periodic f left the padded
+    box and marching cubes stopped at its edge (the known limitation in
+    :mod:`neural.flow`). The openings that :func:`cut_along_boundary` makes lie at the
+    strokes instead.
+
+    Examples
+    --------
+    >>> V = np.array([[0.0, 0, 0], [0, 1, 0], [3, 3, 3], [5, 5, 5]])
+    >>> edges_at_walls(V, np.array([[0, 1, 2], [1, 2, 3]]), np.zeros(3), 1.0, 11)
+    1
+    """
+    from curvenet.core.geometry import boundary_edges
+    F = np.asarray(faces, dtype=np.int64)
+    if not len(F):
+        return 0
+    u = (np.asarray(vertices, np.float64) - origin) / spacing          # node coordinates
+    wall = ((u <= tol) | (u >= n - 1 - tol)).any(axis=1)
+    e = boundary_edges(F)
+    return int((wall[e[:, 0]] & wall[e[:, 1]]).sum())

@@ -124,6 +124,7 @@ from curvenet.core.result import MeshResult
 from curvenet.core.strokes import check_strokes
 from curvenet.core.tolerances import NORM_EPS
 
+from .extract import edges_at_walls
 from .flowfit import FlowFit
 from .frame import Frame, stroke_nodes
 from .presets import FlowConfig, get_config
@@ -150,7 +151,9 @@ class FlowResult(MeshResult):
     vertices : (V, 3) float64, world coordinates
     faces : (F, 3) int64, oriented along grad f (outwards for f > 0 outside)
     report : dict, ``steps`` done per stage, ``interrupted``, ``device``,
-        ``seed``, ``quality``, ``config``, mesh stats
+        ``seed``, ``quality``, ``config``, mesh stats, ``open_at_box`` (the surface's
+        boundary edges at the padded box's walls, :func:`neural.extract.edges_at_walls`:
+        where the zero set left the box)
     f_grid : (n, n, n) float32, normalised f (Eq. 11) at the grid nodes, signed so
         that the box corner (outside) is +1
     origin : (3,) float64, world position of node ``[0, 0, 0]``
@@ -326,6 +329,7 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
     report = {"steps": steps_done, "interrupted": interrupted, "device": str(dev), "seed": seed,
               "quality": quality, "config": cfg.as_dict(), "n_vertices": len(V),
               "n_faces": len(F), "cut_faces": n_cut, "bubbles_dropped": n_bubbles,
+              "open_at_box": edges_at_walls(V, F, origin, h_world, f_np.shape[0]),
               "stroke_length_unit": fit.sampler.total_length}
     if polish is not None:
         report["polish"] = polish

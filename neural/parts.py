@@ -206,6 +206,7 @@ def fit_parts(strokes, labels=None, *, quality: str = "draft", **kwargs):
         split.append({"strokes": part.tolist(), "settings": setting, "report": res.report})
     report = {**split[0]["report"], "split": split, "n_vertices": offset,
               "n_faces": sum(len(f) for f in Fs),
+              "open_at_box": sum(s["report"].get("open_at_box", 0) for s in split),
               "interrupted": len(split) < len(parts)
               or any(s["report"]["interrupted"] for s in split)}
     return MeshResult(np.vstack(Vs), np.vstack(Fs), report)

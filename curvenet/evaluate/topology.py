@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..core.geometry import mesh_edges
+
 __all__ = ["surface_topology", "format_topology"]
 
 
@@ -54,9 +56,7 @@ def surface_topology(vertices, faces) -> dict:
         return {"pieces": 0, "closed": 0, "boundary_loops": 0, "nonmanifold_edges": 0,
                 "euler": 0, "genus": None}
     n = max(len(vertices), int(F.max()) + 1)
-    e = np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1)
-    keys, count = np.unique(e[:, 0] * n + e[:, 1], return_counts=True)    # one int per edge
-    edges = np.stack([keys // n, keys % n], axis=1)
+    edges, count = mesh_edges(F)
     used = np.unique(F)
     label = _components(n, edges)
     pieces, piece = np.unique(label[used], return_inverse=True)      # relabel 0..k-1
@@ -82,7 +82,8 @@ def surface_topology(vertices, faces) -> dict:
 
 
 def format_topology(topology: dict) -> str:
-    """One line for :func:`surface_topology`'s dict.
+    """One line for :func:`surface_topology`'s dict (with ``open_at_box``, the neural
+    route's :func:`neural.extract.edges_at_walls` count, when it is not 0).
 
     Examples
     --------
@@ -103,6 +104,9 @@ def format_topology(topology: dict) -> str:
         loops = topology["boundary_loops"]
         text += (f", {loops} boundary loop{'s' if loops != 1 else ''}, Euler characteristic "
                  f"{topology['euler']}")
+    if topology.get("open_at_box"):
+        text += (" (open where the neural field's zero set reaches its padded box; "
+                 "--closed-box keeps the surface inside)")
     bad = topology["nonmanifold_edges"]
     if bad:
         text += f", {bad} edge{'s' if bad != 1 else ''} in three or more faces"

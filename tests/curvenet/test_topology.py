@@ -56,3 +56,11 @@ def test_no_faces(faces):
     t = surface_topology(np.zeros((4, 3)), faces)
     assert t["pieces"] == 0 and t["genus"] is None
     assert format_topology(t) == "surface: 0 pieces, 0 boundary loops, Euler characteristic 0"
+
+
+def test_an_opening_at_the_neural_box_is_named():
+    t = {"pieces": 1, "closed": 0, "boundary_loops": 2, "nonmanifold_edges": 0, "euler": 0,
+         "genus": None, "open_at_box": 40}
+    assert format_topology(t) == ("surface: 1 piece, 2 boundary loops, Euler characteristic 0"
+                                  " (open where the neural field's zero set reaches its padded"
+                                  " box; --closed-box keeps the surface inside)")

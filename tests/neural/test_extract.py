@@ -5,6 +5,7 @@ import pytest
 import trimesh
 
 from curvenet.neural.extract import (LONE_NODE_AREA, cut_along_boundary, drop_redundant_bubbles,
+                                     edges_at_walls,
                                      face_components, keep_supported_components,
                                      marching_cubes_world)
 
@@ -121,3 +122,21 @@ def test_cut_removes_unsupported_cap_beyond_boundary_loop():
     assert len(F1) == len(m.faces)
     V2, F2 = cut_along_boundary(m.vertices, m.faces, [arc], [equator], band=0.05)
     assert len(F2) == len(m.faces)
+
+
+def test_edges_at_walls_counts_the_openings_marching_cubes_leaves_at_the_grid_edge():
+    """A sphere's zero set cut off by the grid's walls is open there; a sphere inside the
+    grid is closed, and a tube cut open at its ends far from the walls has no edge there."""
+    n, h = 33, 1.0 / 32
+    x = np.linspace(0.0, 1.0, n)
+    X, Y, Z = np.meshgrid(x, x, x, indexing="ij")
+    for centre, radius, expect_open in (((0.5, 0.5, 0.5), 0.3, False),
+                                        ((0.5, 0.5, 0.9), 0.3, True)):
+        f = np.sqrt((X - centre[0]) ** 2 + (Y - centre[1]) ** 2 + (Z - centre[2]) ** 2) - radius
+        V, F = marching_cubes_world(f, np.zeros(3), h)
+        count = edges_at_walls(V, F, np.zeros(3), h, n)
+        assert (count > 0) == expect_open, count
+    tube = trimesh.creation.cylinder(0.2, 0.4, sections=32)
+    tube.apply_translation([0.5, 0.5, 0.5])
+    keep = np.abs(tube.face_normals[:, 2]) < 0.5
+    assert edges_at_walls(tube.vertices, tube.faces[keep], np.zeros(3), h, n) == 0
