@@ -428,7 +428,7 @@ def _progress(total: int, quiet: bool):
 
 def _cmd_surface_batch(args) -> int:
     """``--out-dir``: the batch engine (:mod:`curvenet.batch`), one line per file."""
-    from .batch.run import DaskExecutor, LocalExecutor, run_batch
+    from .batch.run import COLUMN_NOTES, DaskExecutor, LocalExecutor, run_batch
     from .io.tables import check_report_path, write_table
     if args.output is not None:
         raise InvalidParameterError("surface: give -o MESH or --out-dir DIR, not both")
@@ -458,10 +458,7 @@ def _cmd_surface_batch(args) -> int:
     if report is not None:
         header = [f"curvenet surface batch: {len(result.rows)} files, executor "
                   f"{'dask ' + args.scheduler if args.scheduler else f'local, {args.jobs} jobs'}",
-                  f"settings: {options}",
-                  "fidelity: share of stroke length within 1% of the surface's bbox diagonal; "
-                  "fidelity_median / fidelity_p95: stroke-to-surface distance / that diagonal",
-                  "t_*: seconds per stage on the worker"]
+                  f"settings: {options}", *COLUMN_NOTES]
         write_table(report, result.rows, header=header, summary=summary,
                     first=("input", "status", "route", "output", "input_sha256"))
     print(summary)
