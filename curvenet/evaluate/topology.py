@@ -67,15 +67,13 @@ def surface_topology(vertices, faces) -> dict:
     e_piece = lookup[edges[:, 0]]
     e_count = np.bincount(e_piece, minlength=k)
     f_count = np.bincount(lookup[F[:, 0]], minlength=k)
-    open_edges = count == 1
-    not_closed = np.bincount(e_piece[count != 2], minlength=k) > 0
+    closed = np.bincount(e_piece[count != 2], minlength=k) == 0      # every edge in 2 faces
     chi = v_count - e_count + f_count
-    boundary = edges[open_edges]
+    boundary = edges[count == 1]
     loops = 0
     if len(boundary):
         ends = np.unique(boundary)
         loops = len(np.unique(_components(n, boundary)[ends]))
-    closed = ~not_closed
     return {"pieces": int(k), "closed": int(closed.sum()), "boundary_loops": int(loops),
             "nonmanifold_edges": int((count > 2).sum()), "euler": int(chi.sum()),
             "genus": int((2 * closed.sum() - chi[closed].sum()) // 2) if closed.any() else None}
