@@ -45,10 +45,10 @@ DATA = Path(os.environ.get("CURVENET_DATA",
                            Path(__file__).resolve().parents[1].parent / "shared" / "data"))
 SETS = {"cassie": ("sketches/cassie/curves", ".curves"), "networks": ("networks", ".obj"),
         "vns": ("sketches/vns", ".obj")}
-COLUMNS = ("sketch", "classical_s", "classical_fid", "classical_rough", "classical_rough90",
-           "classical_rough_away", "neural_s", "neural_fid", "neural_rough", "neural_rough90",
-           "neural_rough_away", "f1_vs_classical", "f2_vs_classical", "classical_euler",
-           "neural_euler")
+ROUTE_COLUMNS = ("fid", "rough", "rough90", "rough_away", "rough_near", "euler")
+COLUMNS = ("sketch", "classical_s", *(f"classical_{c}" for c in ROUTE_COLUMNS[:-1]),
+           "neural_s", *(f"neural_{c}" for c in ROUTE_COLUMNS[:-1]), "f1_vs_classical",
+           "f2_vs_classical", "classical_euler", "neural_euler")
 
 
 def _measure(res):
@@ -61,8 +61,11 @@ def _measure(res):
     away = cKDTree(samples).query(r["points"])[0] > r["radius"]
     import trimesh
     euler = trimesh.Trimesh(res.mesh.vertices, res.mesh.faces).euler_number
-    return (fid, 1000 * r["median"], 1000 * r["p90"],
-            1000 * np.median(r["values"][away]) if away.any() else float("nan"), euler)
+    per_mille = [1000 * np.median(r["values"][k]) if k.any() else float("nan")
+                 for k in (away, ~away)]
+    return dict(zip(ROUTE_COLUMNS, (f"{fid:.3f}", f"{1000 * r['median']:.2f}",
+                                    f"{1000 * r['p90']:.2f}", f"{per_mille[0]:.2f}",
+                                    f"{per_mille[1]:.2f}", str(euler))))
 
 
 def _row(name: str, path: Path, quality: str, meshes: Path | None = None,
@@ -79,10 +82,10 @@ def _row(name: str, path: Path, quality: str, meshes: Path | None = None,
     c, n = _measure(cla), _measure(neu)
     f1, f2 = (evaluate_mesh(neu.mesh, cla.mesh, n_samples=30_000, threshold=th)["fscore"]
               for th in (0.01, 0.02))
-    return dict(zip(COLUMNS, (name, f"{t_c:.1f}", f"{c[0]:.3f}", f"{c[1]:.2f}", f"{c[2]:.2f}",
-                              f"{c[3]:.2f}", f"{t_n:.1f}", f"{n[0]:.3f}", f"{n[1]:.2f}",
-                              f"{n[2]:.2f}", f"{n[3]:.2f}", f"{f1:.3f}", f"{f2:.3f}",
-                              str(c[4]), str(n[4]))))
+    return {"sketch": name, "classical_s": f"{t_c:.1f}", "neural_s": f"{t_n:.1f}",
+            **{f"classical_{k}": v for k, v in c.items()},
+            **{f"neural_{k}": v for k, v in n.items()},
+            "f1_vs_classical": f"{f1:.3f}", "f2_vs_classical": f"{f2:.3f}"}
 
 
 def _paths(names):
@@ -134,7 +137,9 @@ def main() -> None:
               f"{np.median(col['classical_rough']):.2f}, neural "
               f"{np.median(col['neural_rough']):.2f} (away from the strokes "
               f"{np.nanmedian(col['classical_rough_away']):.2f} and "
-              f"{np.nanmedian(col['neural_rough_away']):.2f}); neural fidelity median "
+              f"{np.nanmedian(col['neural_rough_away']):.2f}, near them "
+              f"{np.nanmedian(col['classical_rough_near']):.2f} and "
+              f"{np.nanmedian(col['neural_rough_near']):.2f}); neural fidelity median "
               f"{np.median(col['neural_fid']):.1%}, min {col['neural_fid'].min():.1%}; "
               f"F at 2% against classical median {np.median(col['f2_vs_classical']):.3f}")
 
