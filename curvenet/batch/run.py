@@ -60,8 +60,9 @@ STATUSES = ("ok", "skipped", "error", "internal")
 #: What the report's measured columns mean (lines of its header).
 COLUMN_NOTES = ("fidelity: share of stroke length within 1% of the surface's bbox diagonal; "
                 "fidelity_median / fidelity_p95: stroke-to-surface distance / that diagonal",
-                "pieces, closed, boundary_loops, genus: the surface's topology (genus of its "
-                "closed pieces; curvenet.evaluate.topology)",
+                "pieces, closed, boundary_loops, genus, nonmanifold_edges: the surface's "
+                "topology (genus of its closed pieces; edges in three or more faces, such as "
+                "walls inside a solid or fins; curvenet.evaluate.topology)",
                 "t_*: seconds per stage on the worker")
 
 #: Tile size (pixels) of the per-file pictures of a contact sheet.
@@ -120,7 +121,8 @@ class BatchResult:
     ``rows[i]`` has ``input``, ``output``, ``status`` (one of :data:`STATUSES`) and, when
     surfaced, ``input_sha256``, ``output_sha256``, ``route``, ``decision``, ``patches``,
     ``coverage``, ``faces``, ``fidelity``, ``fidelity_median``, ``fidelity_p95``,
-    ``pieces``, ``closed``, ``boundary_loops``, ``genus`` (the surface's topology),
+    ``pieces``, ``closed``, ``boundary_loops``, ``genus``, ``nonmanifold_edges`` (the
+    surface's topology),
     ``t_<stage>`` seconds and ``t_total``; failed rows carry ``error``.
     """
 
@@ -216,7 +218,8 @@ def _surface_file(local: str, options: BatchOptions, tmp: str, *, preview, tile,
                fidelity=fid["fidelity"], fidelity_median=fid["median"],
                fidelity_p95=fid["p95"],
                **{k: res.diagnostics["topology"][k]
-                  for k in ("pieces", "closed", "boundary_loops", "genus")},
+                  for k in ("pieces", "closed", "boundary_loops", "genus",
+                            "nonmanifold_edges")},
                mesh_bytes=data.encode() if isinstance(data, str) else bytes(data))
     name = Path(local).name
     strokes = res.sketch if res.sketch is not None else None

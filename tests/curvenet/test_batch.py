@@ -152,8 +152,9 @@ def test_report_rows_and_contact_sheet(tmp_path):
         # classical patches interpolate their boundary curves
         assert row["fidelity"] == pytest.approx(1.0) and row["patches"] >= 6
         assert {"t_snap", "t_patches", "t_classical", "t_fidelity", "t_total"} <= set(row)
-        # four closed solids of genus 0: one closed piece each
-        assert (row["pieces"], row["closed"], row["boundary_loops"], row["genus"]) == (1, 1, 0, 0)
+        # four closed solids of genus 0: one closed piece each, no walls
+        assert (row["pieces"], row["closed"], row["boundary_loops"], row["genus"],
+                row["nonmanifold_edges"]) == (1, 1, 0, 0, 0)
         assert len(row["input_sha256"]) == 64 and os.path.isfile(row["output"])
     assert res.rows[4]["status"] == "error" and "bad.obj:1" in res.rows[4]["error"]
     from matplotlib.image import imread
