@@ -145,8 +145,9 @@ class FlowFit:
         scale = _smoothness_scale(strokes_unit, cfg)
         self.smooth_scale = None if scale is None else torch.as_tensor(scale, device=dev,
                                                                        dtype=self.dtype)
-        self.solver = PoissonSolver(cfg.res, device=dev, dtype=self.dtype, boundary=cfg.boundary,
-                                    lowpass=cfg.lowpass)
+        self.solvers = {r: PoissonSolver(r, device=dev, dtype=self.dtype, boundary=cfg.boundary,
+                                         lowpass=cfg.lowpass)
+                        for r in {cfg.res, cfg.init_res or cfg.res}}
         self.f = None                  # the last solved f (unit-cube grid)
         self.lam = None                # d(data loss) / d(splat), for poisson_every > 1
         self.data = float("nan")       # the last solved data loss
@@ -191,7 +192,7 @@ class FlowFit:
             full = Stage("full", cfg.steps, self._flow_step("full", cfg.steps))
         return [first, full]
 
-    def solve(self, points, values, normalize, need_adjoint, n_stroke=None, mass=None):
+    def solve(self, points, values, normalize, need_adjoint, n_stroke=None, mass=None, res=None):
         """Splat -> FFT Poisson -> Eq. 11; returns (f_grid, data loss, raw grid).
 
         The first ``n_stroke`` (default ``cfg.n_stroke``) points are the data samples
@@ -200,13 +201,14 @@ class FlowFit:
         """
         from .losses import data_loss
         from .poisson import interpolate, normalize_scale_shift, normalize_splat, splat
-        grid, wsum = splat(points, values, self.cfg.res, mass)
+        res = res or self.cfg.res
+        grid, wsum = splat(points, values, res, mass)
         raw = grid
         if need_adjoint:
             raw.retain_grad()
         if normalize:
             grid = normalize_splat(grid, wsum)
-        f = self.solver.solve(grid)
+        f = self.solvers[res].solve(grid)
         f_s = interpolate(f, points[: n_stroke or self.cfg.n_stroke])
         f, f_s = normalize_scale_shift(f, f_s)
         return f, data_loss(f_s), raw
@@ -325,6 +327,7 @@ class FlowFit:
         from .poisson import splat
         cfg, net, gen = self.cfg, self.net, self.gen
         full = stage == "full"
+        res = cfg.res if full else (cfg.init_res or cfg.res)
 
         def step(k):
             x_s, t_s = self.sampler.sample(cfg.n_stroke, gen)
@@ -341,10 +344,10 @@ class FlowFit:
             do_solve = (k % cfg.poisson_every == 0) or k == n_steps - 1 or self.lam is None
             if do_solve:
                 f, vals["data"], raw = self.solve(pts, gv, normalize, cfg.poisson_every > 1,
-                                                  n_stroke=len(x_s))
+                                                  n_stroke=len(x_s), res=res)
                 data_term = cfg.w_data * vals["data"]
             else:
-                data_term = (self.lam * splat(pts, gv, cfg.res)[0]).sum()
+                data_term = (self.lam * splat(pts, gv, res)[0]).sum()
             loss = (cfg.w_align * vals["align"] + cfg.w_curl * vals["curl"]
                     + cfg.w_eik * vals["eik"] + data_term)
             for term, w in (("smooth", cfg.w_smooth), ("normal", cfg.w_normal)):

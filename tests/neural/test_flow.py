@@ -78,6 +78,24 @@ def test_poisson_every_runs():
     assert np.isfinite(r.history["full"]["total"]).all()
 
 
+def test_init_res_solves_the_initialisation_stage_on_its_own_grid(monkeypatch):
+    """The initialisation stage integrates f on the ``init_res`` grid, the full stage and the
+    result on ``res``; the full stage's first surface samples come from the coarse f."""
+    grids = []
+    real = FlowFit.solve
+
+    def spy(self, *args, **kwargs):
+        out = real(self, *args, **kwargs)
+        grids.append(out[0].shape)
+        return out
+
+    monkeypatch.setattr(FlowFit, "solve", spy)
+    r = fit_flow_surface(_circles(), progress=False, **dict(TINY, init_res=16))
+    assert grids == [(16,) * 3] * 3 + [(32,) * 3] * 4
+    assert r.f_grid.shape == (32,) * 3 and len(r.faces)
+    assert np.isfinite(r.history["full"]["total"]).all()
+
+
 def test_smooth_near_weights_the_smoothness_term_down_next_to_the_strokes():
     """With ``smooth_near`` each surface sample's smoothness term is scaled by its weight
     relative to ``w_smooth`` (at most 1, the paper's 0.01 / 0.1 next to a stroke): in the

@@ -32,7 +32,10 @@ def test_overrides_and_presets():
                                       ({"smooth_near": -1.0}, "smooth_near"),
                                       ({"w_smooth_near": -0.1}, "w_smooth_near"),
                                       ({"subdivide": 3}, "subdivide"),
-                                      ({"subdivide": 0.5}, "subdivide")])
+                                      ({"subdivide": 0.5}, "subdivide"),
+                                      ({"init_res": 4}, "init_res"),
+                                      ({"init_res": 256}, "init_res"),
+                                      ({"init_res": 32.5}, "init_res")])
 def test_bad_overrides(kw, match):
     with pytest.raises(ValueError, match=match):
         get_config("draft", **kw)
