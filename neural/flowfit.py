@@ -100,6 +100,12 @@ def _smoothness_scale(strokes_unit, cfg: FlowConfig):
     return (cfg.w_smooth_near + t * (cfg.w_smooth - cfg.w_smooth_near)) / cfg.w_smooth
 
 
+def _init_res(cfg: FlowConfig) -> int:
+    """The grid of the initialisation stage: ``cfg.init_res``, never finer than ``cfg.res``
+    (a part fitted on a coarser grid, :mod:`neural.parts`); ``cfg.res`` when 0."""
+    return min(cfg.init_res, cfg.res) if cfg.init_res else cfg.res
+
+
 class FlowFit:
     """One flow fit: the network, the samplers, the Poisson solver and the current f.
 
@@ -147,7 +153,7 @@ class FlowFit:
                                                                        dtype=self.dtype)
         self.solvers = {r: PoissonSolver(r, device=dev, dtype=self.dtype, boundary=cfg.boundary,
                                          lowpass=cfg.lowpass)
-                        for r in {cfg.res, cfg.init_res or cfg.res}}
+                        for r in {cfg.res, _init_res(cfg)}}
         self.f = None                  # the last solved f (unit-cube grid)
         self.lam = None                # d(data loss) / d(splat), for poisson_every > 1
         self.data = float("nan")       # the last solved data loss
@@ -327,7 +333,7 @@ class FlowFit:
         from .poisson import splat
         cfg, net, gen = self.cfg, self.net, self.gen
         full = stage == "full"
-        res = cfg.res if full else (cfg.init_res or cfg.res)
+        res = cfg.res if full else _init_res(cfg)
 
         def step(k):
             x_s, t_s = self.sampler.sample(cfg.n_stroke, gen)

@@ -110,8 +110,10 @@ class FlowConfig:
     res : int
         Poisson grid resolution per axis (paper: 256).
     init_res : int
-        Poisson grid resolution of the initialisation stage (strokes only); 0: ``res``,
-        as in the paper. The full stage starts from the zero set of that coarser f.
+        Poisson grid resolution of the initialisation stage (strokes only), at most
+        ``res`` (a coarser ``res``, a small part's in :mod:`neural.parts` or one set by
+        hand, takes the stage with it); 0: ``res``, as in the paper. The full stage
+        starts from the zero set of that coarser f.
     padding : float
         Padding of the sketch's bounding box on every side, as a fraction of its
         longest side (paper: 0.2, Sec. 4.4.1).
@@ -360,9 +362,8 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
         raise ValueError(f"handles must be 0 or an odd positive integer, got {cfg.handles!r}")
     if cfg.res < 8:
         raise ValueError(f"res must be at least 8, got {cfg.res}")
-    if int(cfg.init_res) != cfg.init_res or not (cfg.init_res == 0 or 8 <= cfg.init_res <= cfg.res):
-        raise ValueError(f"init_res must be 0 or an integer in [8, res = {cfg.res}], "
-                         f"got {cfg.init_res!r}")
+    if int(cfg.init_res) != cfg.init_res or not (cfg.init_res == 0 or cfg.init_res >= 8):
+        raise ValueError(f"init_res must be 0 or an integer of at least 8, got {cfg.init_res!r}")
     if cfg.res > MAX_RES:
         need = GRID_BYTES_PER_VOXEL * cfg.res ** 3 / 2**30
         raise ValueError(f"res {cfg.res} needs about {need:.3g} GiB for its grids; "

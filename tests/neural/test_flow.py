@@ -94,6 +94,9 @@ def test_init_res_solves_the_initialisation_stage_on_its_own_grid(monkeypatch):
     assert grids == [(16,) * 3] * 3 + [(32,) * 3] * 4
     assert r.f_grid.shape == (32,) * 3 and len(r.faces)
     assert np.isfinite(r.history["full"]["total"]).all()
+    grids.clear()
+    fit_flow_surface(_circles(), progress=False, **dict(TINY, init_res=64))
+    assert set(grids) == {(32,) * 3}        # never finer than res
 
 
 def test_smooth_near_weights_the_smoothness_term_down_next_to_the_strokes():

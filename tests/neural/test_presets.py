@@ -34,11 +34,17 @@ def test_overrides_and_presets():
                                       ({"subdivide": 3}, "subdivide"),
                                       ({"subdivide": 0.5}, "subdivide"),
                                       ({"init_res": 4}, "init_res"),
-                                      ({"init_res": 256}, "init_res"),
                                       ({"init_res": 32.5}, "init_res")])
 def test_bad_overrides(kw, match):
     with pytest.raises(ValueError, match=match):
         get_config("draft", **kw)
+
+
+def test_a_coarser_grid_takes_the_initialisation_stage_with_it():
+    """``default`` with a grid coarser than its ``init_res`` (a small part's, or one set by
+    hand) is valid."""
+    assert get_config("default", res=32).init_res == 64
+    assert get_config("default", res=48, init_res=256).res == 48
 
 
 def test_bad_quality():
