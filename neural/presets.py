@@ -488,7 +488,6 @@ class CreaseConfig:
     lr: float = 2e-3
     batch: int = 3000
     res: int = 128
-    init_res: int = 0
     strip_width: float = 0.08
     strip_spacing: float = 0.025
     mollifier_radius: float = 0.1
