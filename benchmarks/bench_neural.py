@@ -29,7 +29,7 @@ wireframes ``--reference-quality`` and ``draft`` on clean sparse wireframes whos
            fitted part by part,
            :mod:`neural.parts`, as the route does: ``--set split_parts=0`` for one
            field), each with the fit seeds ``--fit-seeds`` (default 0); F-score at 0.01 and
-           Chamfer against the true surface
+           Chamfer against the true surface; ``--wireframes NAME ...`` takes some of them
 vns        time and stroke fidelity per sketch (``--vns-quality``, default draft) on
            several vns sketches (``--vns all``: every ``*.obj`` under sketches/vns), PNG
            previews under ``--png-dir`` (default /tmp); fidelity is the share of stroke
@@ -259,6 +259,8 @@ def main(argv=None):
                     help="seeds of the fit itself in the wireframes section")
     ap.add_argument("--timeout", type=float, default=3600,
                     help="seconds per rough sphere of the spheres section (loaded machines: more)")
+    ap.add_argument("--wireframes", nargs="*", default=WIREFRAMES, choices=WIREFRAMES,
+                    metavar="NAME", help="shapes of the wireframes section (default: all)")
     ap.add_argument("--set", nargs="*", default=[], metavar="NAME=VALUE",
                     help="FlowConfig overrides (sections spheres, heldout, wireframes, vns)")
     ap.add_argument("--vns-quality", default="draft", help="preset of the vns section")
@@ -331,7 +333,7 @@ def main(argv=None):
                      f"{r.get('fidelity', 0.0):.3f}", f"{r['time_s']:.1f}s")
     if "wireframes" in a.only:
         _row("wireframes", "shape", "quality", "fit seed", "F-score@0.01", "Chamfer", "wall")
-        for name, seed in itertools.product(WIREFRAMES, a.fit_seeds):
+        for name, seed in itertools.product(a.wireframes, a.fit_seeds):
             for quality in ("draft", a.reference_quality):
                 r = _run({**base, "kind": "wireframe", "shape": name, "quality": quality,
                           "fit_seed": seed, "overrides": overrides}, timeout=a.timeout)

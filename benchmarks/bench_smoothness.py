@@ -4,7 +4,7 @@ Run from the repository root::
 
     nice -n 5 python benchmarks/bench_smoothness.py --out smooth.tsv
         [--sketches vns/torus,cassie/01-0-1] [--quality draft] [--threads 2] [--meshes DIR]
-        [--set lowpass=0 ...]
+        [--seed 0] [--set lowpass=0 ...]
 
 Each sketch (default: the 22 of ``$CURVENET_DATA/sketches/vns``, ``input/`` included;
 ``--sketches`` takes ``SET/STEM`` names of ``vns``, ``cassie`` and ``networks``, the
@@ -69,12 +69,13 @@ def _measure(res):
 
 
 def _row(name: str, path: Path, quality: str, meshes: Path | None = None,
-         settings: dict | None = None) -> dict:
+         settings: dict | None = None, seed: int = 0) -> dict:
     t = time.perf_counter()
     cla = curvenet.surface(path, method="classical")
     t_c = time.perf_counter() - t
     t = time.perf_counter()
-    neu = curvenet.surface(path, method="neural", quality=quality, neural_options=settings)
+    neu = curvenet.surface(path, method="neural", quality=quality, neural_options=settings,
+                           seed=seed)
     t_n = time.perf_counter() - t
     if meshes is not None:
         for route, res in (("classical", cla), ("neural", neu)):
@@ -108,6 +109,7 @@ def main() -> None:
     ap.add_argument("--threads", type=int, default=0, help="torch threads (0: torch's)")
     ap.add_argument("--meshes", type=Path, default=None,
                     help="folder for both surfaces of each sketch (SET_STEM_ROUTE.ply)")
+    ap.add_argument("--seed", type=int, default=0, help="seed of the neural fit")
     ap.add_argument("--set", nargs="*", default=[], metavar="NAME=VALUE",
                     help="FlowConfig fields over the preset, e.g. lowpass=0")
     args = ap.parse_args()
@@ -123,7 +125,7 @@ def main() -> None:
     rows = []
     for name, path in _paths(list(filter(None, args.sketches.split(","))) or ["vns"]):
         try:
-            row = _row(name, path, args.quality, args.meshes, settings)
+            row = _row(name, path, args.quality, args.meshes, settings, args.seed)
         except Exception as err:  # noqa: BLE001 - a failed sketch is a row, not the end
             row = dict.fromkeys(COLUMNS, "-") | {"sketch": f"{name}: {err}"[:80]}
         rows.append(row)

@@ -100,6 +100,13 @@ def _smoothness_scale(strokes_unit, cfg: FlowConfig):
     return (cfg.w_smooth_near + t * (cfg.w_smooth - cfg.w_smooth_near)) / cfg.w_smooth
 
 
+#: Standard deviation, in cells of its grid, of the Gaussian that low-passes the
+#: initialisation's f before the bridge fits g to its gradient: that f carries the
+#: Monte-Carlo lumps of the stroke splats at the cell scale, and g fitted to them passes
+#: them on to the full stage (a rougher surface).
+BRIDGE_BLUR = 1.0
+
+
 def _init_res(cfg: FlowConfig) -> int:
     """The grid of the initialisation stage: ``cfg.init_res``, never finer than ``cfg.res``
     (a part fitted on a coarser grid, :mod:`neural.parts`); ``cfg.res`` when 0."""
@@ -162,12 +169,14 @@ class FlowFit:
         self.anchors = None if anchors is None else tuple(
             torch.as_tensor(a, device=dev, dtype=self.dtype)
             for a in (self.frame.to_unit(anchors[0]), anchors[1]))
+        self.bridge_f = None           # the bridge's target field (bridge_steps)
         self.prefit = None
         if init_mesh is not None:
             P, target, mesh_surf = _prefit_targets(init_mesh, self.frame, cfg.sigma, self.rng)
             self.prefit = (torch.as_tensor(P, device=dev, dtype=self.dtype),
                            torch.as_tensor(target, device=dev, dtype=self.dtype), mesh_surf)
-        names = ("prefit",) if init_mesh is not None else ("init",)
+        names = ("prefit",) if init_mesh is not None else (
+            ("init", "bridge") if cfg.bridge_steps else ("init",))
         self.history = {name: {t: [] for t in _TERMS} for name in names + ("full",)}
 
     def geometric_stage(self) -> Stage:
@@ -196,6 +205,9 @@ class FlowFit:
         else:
             first = Stage("init", cfg.init_steps, self._flow_step("init", cfg.init_steps))
             full = Stage("full", cfg.steps, self._flow_step("full", cfg.steps))
+            if cfg.bridge_steps:
+                return [first, Stage("bridge", cfg.bridge_steps, self._bridge_step,
+                                     start=self._bridge_start), full]
         return [first, full]
 
     def solve(self, points, values, normalize, need_adjoint, n_stroke=None, mass=None, res=None):
@@ -312,6 +324,33 @@ class FlowFit:
                              dtype=self.dtype)
         self.f = self.solve_strokes_only(ms)
         return self.f
+
+    def _bridge_start(self):
+        """The bridge's target: the initialisation's f (from the strokes alone when that
+        stage ran no step) low-passed by a Gaussian of :data:`BRIDGE_BLUR` cells."""
+        import torch
+        from scipy.ndimage import gaussian_filter
+        if self.f is None:
+            self.f = self.solve_strokes_only()
+        mode = "wrap" if self.cfg.boundary == "periodic" else "nearest"
+        blurred = gaussian_filter(self.f.detach().cpu().numpy(), BRIDGE_BLUR, mode=mode)
+        self.bridge_f = torch.as_tensor(blurred, device=self.dev, dtype=self.dtype)
+
+    def _bridge_step(self, k):
+        """g fitted to ``sigma`` times the unit gradient of the initialisation's f, low-passed
+        (:meth:`_bridge_start`), at samples of its zero set and of the strokes
+        (``cfg.bridge_steps``; see :mod:`neural.presets`), so that the full stage's first
+        surface samples splat a g that already points along the surface they lie on."""
+        import torch
+
+        from .poisson import interpolate
+        x_u = self._surface_samples(self.cfg.n_surface)
+        x = self._data_points(1) if x_u is None else torch.cat([x_u, self._data_points(1)])
+        _, grad = interpolate(self.bridge_f, x, with_gradient=True)
+        target = self.cfg.sigma * grad / grad.norm(dim=-1, keepdim=True).clamp(min=NORM_EPS)
+        loss = ((self.net(x) - target) ** 2).sum(-1).mean()
+        row = self._row({"total": loss})
+        return Step(loss, dict(zip(_TERMS, row)), after=lambda: self._record("bridge", k, row))
 
     def _surface_samples(self, n):
         """``n`` samples on the zero set of the last solved f, or None before the first."""

@@ -39,6 +39,15 @@ from the paper in:
   full stage's 128^3: that stage fits g to the strokes alone, and on the coarser grid
   it takes half the time, with surfaces as smooth and as close to the strokes
   (``benchmarks/README.md``);
+- ``default`` only, a bridge between the two stages (``bridge_steps``): the
+  initialisation stage fits g at the strokes alone (its curl term samples the volume,
+  not a surface), so at the full stage's first step nothing has fitted g on the rest
+  of the zero set yet; splatted with the first surface samples, that g dents the
+  surface where no stroke holds it (the top of a torus's tube between its meridians),
+  and the later steps keep the dents. The bridge first fits g to ``sigma`` times the
+  unit gradient of the initialisation's f, low-passed by a cell, at samples of its
+  zero set and of the strokes, as the refinement path's prefit fits g to a given
+  surface (``benchmarks/README.md``);
 - ``default`` only, the polish (``polish``, ``polish_rounds``, ``polish_strip``,
   ``average_from``): f re-integrated from the network averaged over the last 40 % of
   the full stage, with the stroke samples in place of the surface samples next to
@@ -143,6 +152,12 @@ class FlowConfig:
     init_steps, steps : int
         Adam steps of the initialisation stage and of the full stage
         (paper: 200 and 800, Sec. 5.2).
+    bridge_steps : int
+        Adam steps between them fitting g to ``sigma`` times the unit gradient of the
+        initialisation stage's f (low-passed, :data:`neural.flowfit.BRIDGE_BLUR`), at
+        ``n_surface`` samples of its zero set and ``n_stroke`` stroke samples a step (no
+        Poisson solve); 0: none, as in the paper. Not run when refining an
+        ``init_mesh`` (its prefit does the same).
     lr : float
         Adam learning rate. grad_clip : float, gradient-norm clip (0 = off).
     w_align, w_smooth, w_data, w_eik, w_curl : float
@@ -254,6 +269,7 @@ class FlowConfig:
     n_surface: int = 2500
     n_volume: int = 1500
     init_steps: int = 60
+    bridge_steps: int = 0
     steps: int = 200
     lr: float = 2e-4
     grad_clip: float = 10.0
@@ -294,8 +310,8 @@ PRESETS: dict[str, FlowConfig] = {
                         n_volume=600, init_steps=40, steps=100, lr=3e-4, poisson_every=1,
                         w_smooth=0.1, attach=10.0, attach_band=0.005, subdivide=1,
                         split_parts=1),
-    "default": FlowConfig(init_res=64, steps=140, w_smooth=0.1, polish=4, polish_rounds=4,
-                          polish_strip=1.0, average_from=0.6, attach=20.0,
+    "default": FlowConfig(init_res=64, bridge_steps=30, steps=140, w_smooth=0.1, polish=4,
+                          polish_rounds=4, polish_strip=1.0, average_from=0.6, attach=20.0,
                           attach_band=0.005, attach_reach=6.0, attach_normals=40.0,
                           handles=5, subdivide=1, split_parts=1),
     "paper": FlowConfig(res=256, width=256, hidden_layers=4, n_stroke=10000, n_surface=15000,
@@ -347,7 +363,7 @@ def get_config(quality: str = "draft", **overrides) -> FlowConfig:
         v = getattr(cfg, name)
         if int(v) != v or v < 1:
             raise ValueError(f"{name} must be a positive integer, got {v!r}")
-    for name in ("hidden_layers", "init_steps", "steps", "prefit_steps",
+    for name in ("hidden_layers", "init_steps", "bridge_steps", "steps", "prefit_steps",
                  "geometric_init_steps", "polish"):
         v = getattr(cfg, name)
         if int(v) != v or v < 0:

@@ -34,7 +34,9 @@ def test_overrides_and_presets():
                                       ({"subdivide": 3}, "subdivide"),
                                       ({"subdivide": 0.5}, "subdivide"),
                                       ({"init_res": 4}, "init_res"),
-                                      ({"init_res": 32.5}, "init_res")])
+                                      ({"init_res": 32.5}, "init_res"),
+                                      ({"bridge_steps": -1}, "bridge_steps"),
+                                      ({"bridge_steps": 2.5}, "bridge_steps")])
 def test_bad_overrides(kw, match):
     with pytest.raises(ValueError, match=match):
         get_config("draft", **kw)
