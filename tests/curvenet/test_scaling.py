@@ -61,7 +61,7 @@ def _exponents(make, tmp_path, with_surface) -> dict:
         write_sketch(paths[-1], sketch)
         curves.append(len(sketch.strokes))
     _stages(paths[0], with_surface)                          # imports, caches
-    best = [dict.fromkeys(_stages(p, False), np.inf) for p in paths[1:]]
+    best = [{} for _ in paths[1:]]                           # stage -> least seconds
     for r in range(ROUNDS):
         for b, path in zip(best, paths[1:]):
             # the classical surface (grid boxes), the slowest stage, in the first round only
