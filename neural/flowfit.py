@@ -338,14 +338,14 @@ class FlowFit:
 
     def _bridge_step(self, k):
         """g fitted to ``sigma`` times the unit gradient of the initialisation's f, low-passed
-        (:meth:`_bridge_start`), at samples of its zero set and of the strokes
-        (``cfg.bridge_steps``; see :mod:`neural.presets`), so that the full stage's first
-        surface samples splat a g that already points along the surface they lie on."""
-        import torch
-
+        (:meth:`_bridge_start`), at samples of its zero set (``cfg.bridge_steps``; see
+        :mod:`neural.presets`), so that the full stage's first surface samples splat a g that
+        already points along the surface they lie on. The strokes are not sampled: the
+        initialisation fitted g there."""
         from .poisson import interpolate
-        x_u = self._surface_samples(self.cfg.n_surface)
-        x = self._data_points(1) if x_u is None else torch.cat([x_u, self._data_points(1)])
+        x = self._surface_samples(self.cfg.n_surface)
+        if x is None:                  # f does not cross zero: the strokes, where it should
+            x = self._data_points(1)
         _, grad = interpolate(self.bridge_f, x, with_gradient=True)
         target = self.cfg.sigma * grad / grad.norm(dim=-1, keepdim=True).clamp(min=NORM_EPS)
         loss = ((self.net(x) - target) ** 2).sum(-1).mean()

@@ -46,8 +46,8 @@ from the paper in:
   surface where no stroke holds it (the top of a torus's tube between its meridians),
   and the later steps keep the dents. The bridge first fits g to ``sigma`` times the
   unit gradient of the initialisation's f, low-passed by a cell, at samples of its
-  zero set and of the strokes, as the refinement path's prefit fits g to a given
-  surface (``benchmarks/README.md``);
+  zero set (not at the strokes, where the initialisation fitted g), as the refinement
+  path's prefit fits g to a given surface (``benchmarks/README.md``);
 - ``default`` only, the polish (``polish``, ``polish_rounds``, ``polish_strip``,
   ``average_from``): f re-integrated from the network averaged over the last 40 % of
   the full stage, with the stroke samples in place of the surface samples next to
@@ -155,8 +155,8 @@ class FlowConfig:
     bridge_steps : int
         Adam steps between them fitting g to ``sigma`` times the unit gradient of the
         initialisation stage's f (low-passed, :data:`neural.flowfit.BRIDGE_BLUR`), at
-        ``n_surface`` samples of its zero set and ``n_stroke`` stroke samples a step (no
-        Poisson solve); 0: none, as in the paper. Not run when refining an
+        ``n_surface`` samples of its zero set a step (no Poisson solve); 0: none, as in
+        the paper. Not run when refining an
         ``init_mesh`` (its prefit does the same).
     lr : float
         Adam learning rate. grad_clip : float, gradient-norm clip (0 = off).
