@@ -28,8 +28,9 @@ wireframes ``--reference-quality`` and ``draft`` on clean sparse wireframes whos
            prism and a gabled house (flat faces and a notch that no stroke crosses;
            fitted part by part,
            :mod:`neural.parts`, as the route does: ``--set split_parts=0`` for one
-           field), each with the fit seeds ``--fit-seeds`` (default 0); F-score at 0.01 and
-           Chamfer against the true surface; ``--wireframes NAME ...`` takes some of them
+           field), and a capped cylinder drawn by its two rims and 4 rulings; each
+           with the fit seeds ``--fit-seeds`` (default 0); F-score at 0.01 and Chamfer
+           against the true surface; ``--wireframes NAME ...`` takes some of them
 vns        time and stroke fidelity per sketch (``--vns-quality``, default draft) on
            several vns sketches (``--vns all``: every ``*.obj`` under sketches/vns), PNG
            previews under ``--png-dir`` (default /tmp); fidelity is the share of stroke
@@ -114,13 +115,15 @@ def _worker(spec: dict) -> dict:
 
 
 WIREFRAMES = ["torus r0.25 4x2", "torus r0.4 4x2", "torus r0.4 3x2", "sphere 3 circles",
-              "2 spheres gap0.2", "box edges", "l_prism edges", "house edges"]
+              "2 spheres gap0.2", "box edges", "l_prism edges", "house edges", "cylinder 4x1"]
 
 
 def _wireframe(name: str):
     """``(curves, true surface (trimesh.Trimesh))`` of a ``WIREFRAMES`` name; ``2 spheres
     gapG``: two unit spheres of 3 great circles each, ``G`` apart; ``NAME edges``: the
-    crease curves alone of the polyhedron ``curvenet.datasets.shapes.SHAPES[NAME]``."""
+    crease curves alone of the polyhedron ``curvenet.datasets.shapes.SHAPES[NAME]``;
+    ``cylinder AxH``: a capped cylinder (radius 0.5, height 1.5) of ``A`` rulings and
+    ``H + 1`` circles, no stroke on its caps."""
     import trimesh
 
     from curvenet.datasets import sections, shapes
@@ -135,6 +138,9 @@ def _wireframe(name: str):
         shape = shapes.SHAPES[name.split()[0]]()
     elif name.startswith("sphere"):
         shape = sections.great_circles(int(name.split()[1]))
+    elif name.startswith("cylinder"):
+        around, rows = (int(k) for k in name.split()[1].split("x"))
+        shape = shapes.capped_cylinder(0.5, 1.5, n_around=around, n_height=rows)
     else:
         _, r, counts = name.split()
         meridians, rings = (int(k) for k in counts.split("x"))
