@@ -136,6 +136,13 @@ def test_the_bridge_turns_g_along_the_initialisation_surface():
     r = fit_flow_surface(_circles(), progress=False, **dict(TINY, init_steps=0, bridge_steps=2))
     assert r.report["steps"]["bridge"] == 2 and len(r.faces)   # f from the strokes alone
 
+    # an f that does not cross zero has no zero set to sample: the bridge fits g at the strokes
+    fit = FlowFit(_circles(), cfg, torch.device("cpu"), 0, None)
+    fit._surface_samples = lambda n: None
+    train(fit.net.parameters(), [fit.stages()[1]], lr=cfg.lr)
+    losses = fit.history["bridge"]["total"]
+    assert np.isfinite(losses).all() and losses[-1] < 0.5 * losses[0]
+
 
 def test_smooth_near_weights_the_smoothness_term_down_next_to_the_strokes():
     """With ``smooth_near`` each surface sample's smoothness term is scaled by its weight
