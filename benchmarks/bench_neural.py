@@ -115,7 +115,11 @@ def _worker(spec: dict) -> dict:
 
 
 WIREFRAMES = ["torus r0.25 4x2", "torus r0.4 4x2", "torus r0.4 3x2", "sphere 3 circles",
-              "2 spheres gap0.2", "box edges", "l_prism edges", "house edges", "cylinder 4x1"]
+              "2 spheres gap0.2", "box edges", "l_prism edges", "house edges", "cylinder 4x1",
+              "sphere 3 circles turned", "cylinder 4x1 turned"]
+#: Euler angles (degrees, xyz) of a ``turned`` wireframe: the turn of three great circles
+#: whose bounding box is smallest against the sphere's (its sides at 0.94 of the radius).
+TURN = (45.0, 20.0, 45.0)
 
 
 def _wireframe(name: str):
@@ -123,8 +127,16 @@ def _wireframe(name: str):
     gapG``: two unit spheres of 3 great circles each, ``G`` apart; ``NAME edges``: the
     crease curves alone of the polyhedron ``curvenet.datasets.shapes.SHAPES[NAME]``;
     ``cylinder AxH``: a capped cylinder (radius 0.5, height 1.5) of ``A`` rulings and
-    ``H + 1`` circles, no stroke on its caps."""
+    ``H + 1`` circles, no stroke on its caps; ``NAME turned``: NAME turned by
+    :data:`TURN` (its rims and poles no longer on the sides of the axis-aligned box)."""
     import trimesh
+    if name.endswith(" turned"):
+        from scipy.spatial.transform import Rotation
+        R = Rotation.from_euler("xyz", TURN, degrees=True).as_matrix()
+        curves, truth = _wireframe(name[:-len(" turned")])
+        truth = truth.copy()
+        truth.vertices = truth.vertices @ R.T
+        return [c @ R.T for c in curves], truth
 
     from curvenet.datasets import sections, shapes
     if name.startswith("2 spheres"):

@@ -153,9 +153,11 @@ class FlowResult(MeshResult):
     report : dict, ``steps`` done per stage, ``interrupted``, ``device``,
         ``seed``, ``quality``, ``config``, mesh stats, ``open_at_box`` (the surface's
         boundary edges at the padded box's walls, :func:`neural.extract.edges_at_walls`:
-        where the zero set left the box)
+        where the zero set left the box), ``rims_closed`` (the sides of the strokes'
+        box the surface was closed on, :func:`neural.rims.close_rims`)
     f_grid : (n, n, n) float32, normalised f (Eq. 11) at the grid nodes, signed so
-        that the box corner (outside) is +1
+        that the box corner (outside) is +1; intersected with the half-spaces behind
+        the closed rims' planes
     origin : (3,) float64, world position of node ``[0, 0, 0]``
     spacing : float, world node spacing
     timings : dict, seconds per stage (``prefit``, ``init``, ``full``,
@@ -204,7 +206,7 @@ def fit_strokes(strokes, labels):
 def fit_flow_surface(strokes, *, labels=None, quality: str = "draft", device="cpu", seed: int = 0,
                      init_mesh=None, anchors=None, progress: bool = True,
                      cut_boundary: bool = True, desc: str = "neural", stop=None,
-                     **overrides) -> FlowResult:
+                     box=None, **overrides) -> FlowResult:
     """Fit a flow-aligned implicit surface to 3D strokes (Zhang et al. 2025).
 
     Parameters
@@ -241,6 +243,10 @@ def fit_flow_surface(strokes, *, labels=None, quality: str = "draft", device="cp
     stop : threading.Event, optional
         Set from another thread, the optimisation stops as at Ctrl-C (see the module
         notes).
+    box : ((3,), (3,)) array_like, optional
+        Lowest and highest corner of the bounding box whose sides may be closed at a rim
+        (``rims``, :func:`neural.rims.close_rims`). Default: the strokes'; a part of a
+        sketch (:func:`neural.parts.fit_parts`) takes the whole sketch's.
     **overrides
         Any :class:`neural.presets.FlowConfig` field (``res=96``, ``steps=50``,
         ``w_smooth=0``...).
@@ -266,8 +272,12 @@ def fit_flow_surface(strokes, *, labels=None, quality: str = "draft", device="cp
     cfg = get_config(quality, **overrides)
     strokes, labels = fit_strokes(strokes, labels)
     dev = torch_device(device)
+    if box is None:
+        points = np.vstack(strokes)
+        box = (points.min(axis=0), points.max(axis=0))
+    box = tuple(np.asarray(c, np.float64).reshape(3) for c in box)
     return _fit(strokes, labels, cfg, dev, int(seed), init_mesh, progress, cut_boundary, quality,
-                anchors=_check_anchors(anchors), desc=desc, stop=stop)
+                anchors=_check_anchors(anchors), desc=desc, stop=stop, box=box)
 
 
 def _check_anchors(anchors):
@@ -288,7 +298,7 @@ def _check_anchors(anchors):
 
 
 def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_boundary, quality,
-         anchors=None, desc="neural", stop=None):
+         anchors=None, desc="neural", stop=None, box=None):
     t_start = time.perf_counter()
     fit = FlowFit(strokes, cfg, dev, seed, init_mesh, anchors)
     stages = fit.stages()
@@ -305,16 +315,17 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
     t0 = time.perf_counter()
     f_final = run.best if run.best is not None else fit.solve_strokes_only()
     anchor_points = None if anchors is None else anchors[0]
-    mesh = _extract(f_final, fit.frame, strokes, labels, cut_boundary, cfg.handles)
+    rims = (box, cfg.rims if anchors is None else 0.0)
+    mesh = _extract(f_final, fit.frame, strokes, labels, cut_boundary, cfg.handles, rims)
     polish = attach = None
     if not interrupted:
         if cfg.polish > 0:
             done, polish = _polished(fit, f_final, mesh, strokes, labels, cut_boundary, cfg,
-                                     anchor_points)
+                                     anchor_points, rims)
         else:
             done = _faired(mesh, strokes, cfg, anchor_points)
         mesh, attach = done[:2]
-    V, F, f_np, origin, h_world, n_cut = mesh
+    V, F, f_np, origin, h_world, n_cut, planes = mesh
     n_bubbles = 0
     if anchors is None and len(F):
         from curvenet.core.fidelity import FIDELITY_TOL_REL
@@ -329,6 +340,7 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
     report = {"steps": steps_done, "interrupted": interrupted, "device": str(dev), "seed": seed,
               "quality": quality, "config": cfg.as_dict(), "n_vertices": len(V),
               "n_faces": len(F), "cut_faces": n_cut, "bubbles_dropped": n_bubbles,
+              "rims_closed": int(np.isfinite(planes).sum()),
               "open_at_box": edges_at_walls(V, F, origin, h_world, f_np.shape[0]),
               "stroke_length_unit": fit.sampler.total_length}
     if polish is not None:
@@ -341,17 +353,20 @@ def _fit(strokes, labels, cfg: FlowConfig, dev, seed, init_mesh, progress, cut_b
 
 def _faired(mesh, strokes, cfg: FlowConfig, anchors=None, before: float | None = None):
     """``mesh`` (:func:`_extract`'s tuple) faired onto its strokes (:func:`_attached`) when
-    ``cfg.attach`` > 0: ``(mesh, attach report or None, stroke fidelity)``. ``before``:
-    the stroke fidelity of ``mesh`` when known."""
+    ``cfg.attach`` > 0, then put back within its closed rims' planes
+    (:func:`neural.rims.clamp_to`): ``(mesh, attach report or None, stroke fidelity)``.
+    ``before``: the stroke fidelity of ``mesh`` when known."""
+    from .rims import clamp_to
     V, F = mesh[:2]
     if cfg.attach > 0 and len(F):
         V, attach = _attached(V, F, strokes, mesh[4], cfg, anchors, before)
+        V = clamp_to(V, *mesh[6])
         return (V,) + tuple(mesh[1:]), attach, attach["fidelity"][int(attach["kept"])]
     return mesh, None, _fidelity(V, F, strokes) if before is None else before
 
 
 def _polished(fit: FlowFit, f, mesh, strokes, labels, cut_boundary, cfg: FlowConfig,
-              anchors=None):
+              anchors=None, rims=(None, 0.0)):
     """The polished surface (:meth:`FlowFit.polish`) if, faired, it holds as much of the
     strokes as the last step's surface faired.
 
@@ -375,7 +390,8 @@ def _polished(fit: FlowFit, f, mesh, strokes, labels, cut_boundary, cfg: FlowCon
     "faired": [bool, bool], "kept": bool})``: each fidelity as faired, or as extracted
     where that surface was not faired.
     """
-    polished = _extract(fit.polish(f), fit.frame, strokes, labels, cut_boundary, cfg.handles)
+    polished = _extract(fit.polish(f), fit.frame, strokes, labels, cut_boundary, cfg.handles,
+                        rims)
     (last, last_ceiling), (raw, ceiling) = (_fidelity_and_ceiling(m, strokes, cfg)
                                             for m in (mesh, polished))
     out = [None, None]                  # the fairing keeps no less than ``last``
@@ -453,18 +469,22 @@ def _stroke_distances(V, F, strokes):
     return d / diag, diag
 
 
-def _extract(f_final, frame: Frame, strokes, labels, cut_boundary, handles: int = 0):
+def _extract(f_final, frame: Frame, strokes, labels, cut_boundary, handles: int = 0,
+             rims=(None, 0.0)):
     """World mesh of f's zero set, its small handles removed
-    (:func:`neural.topology.remove_small_handles` up to ``handles`` cells): supported
-    components, cut along boundary strokes.
+    (:func:`neural.topology.remove_small_handles` up to ``handles`` cells) and closed at
+    the rims on the sides of ``rims[0]`` (a box, :func:`neural.rims.close_rims` with
+    share ``rims[1]``): supported components, cut along boundary strokes.
 
-    Returns ``(V, F, f_np, origin, spacing, n_cut_faces)``; ``f_np`` is signed so that
-    the box corner (outside) is positive.
+    Returns ``(V, F, f_np, origin, spacing, n_cut_faces, (lo, hi))``; ``f_np`` is signed
+    so that the box corner (outside) is positive; ``lo, hi`` (3,) float64 the closed
+    rims' planes (``-inf`` / ``inf`` where none).
     """
     import torch
 
     from .extract import (LONE_NODE_AREA, cut_along_boundary, keep_supported_components,
                           marching_cubes_world)
+    from .rims import close_rims
     f_np = f_final.detach().to("cpu", torch.float32).numpy()
     if f_np[0, 0, 0] < 0:        # the box corner is outside: make f > 0 outside
         f_np = -f_np
@@ -474,6 +494,7 @@ def _extract(f_final, frame: Frame, strokes, labels, cut_boundary, handles: int 
         from .topology import remove_small_handles
         f_np = remove_small_handles(f_np, handles, _stroke_voxels(strokes, origin, h_world,
                                                                   f_np.shape))[0]
+    f_np, lo, hi = close_rims(f_np, origin, h_world, rims[0], strokes, rims[1])
     V, F = marching_cubes_world(f_np, origin, h_world)
     V, F = keep_supported_components(V, F, strokes, 4.0 * h_world, LONE_NODE_AREA * h_world ** 2)
     n_before_cut = len(F)
@@ -481,7 +502,7 @@ def _extract(f_final, frame: Frame, strokes, labels, cut_boundary, handles: int 
         V, F = cut_along_boundary(V, F, [s for s, lab in zip(strokes, labels) if lab == "boundary"],
                                   [s for s, lab in zip(strokes, labels) if lab != "boundary"],
                                   1.5 * h_world)
-    return V, F, f_np, origin, h_world, n_before_cut - len(F)
+    return V, F, f_np, origin, h_world, n_before_cut - len(F), (lo, hi)
 
 
 def _stroke_voxels(strokes, origin, h: float, shape) -> np.ndarray:

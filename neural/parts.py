@@ -164,7 +164,8 @@ def fit_parts(strokes, labels=None, *, quality: str = "draft", **kwargs):
         As :func:`neural.flow.fit_flow_surface`.
     **kwargs
         Its other arguments (``device``, ``seed``, ``progress``, ``cut_boundary``,
-        ``init_mesh``, ``anchors``) and :class:`neural.presets.FlowConfig` overrides.
+        ``init_mesh``, ``anchors``, ``box``: each part's is the whole sketch's unless
+        given) and :class:`neural.presets.FlowConfig` overrides.
         The whole sketch is fitted at once with ``split_parts=0``, and with
         ``init_mesh`` or ``anchors`` (a refinement or a hybrid fill is one surface).
 
@@ -195,6 +196,8 @@ def fit_parts(strokes, labels=None, *, quality: str = "draft", **kwargs):
     extent = np.ptp(np.vstack(strokes), axis=0).max()
     settings = [_part_settings(cfg, [strokes[i] for i in part], extent,
                                length[part].sum() / length.sum()) for part in parts]
+    points = np.vstack(strokes)     # a rim closes on the whole sketch's box, not a part's
+    kwargs = {"box": (points.min(axis=0), points.max(axis=0)), **kwargs}
     results = _fit_side_by_side(parts, settings, strokes, labels, quality, kwargs)
     Vs, Fs, split, offset = [], [], [], 0
     for part, setting, res in zip(parts, settings, results):

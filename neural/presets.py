@@ -83,6 +83,11 @@ pierces the surface with holes a few cells across and spans it with thin strands
 of handles on the surface of a genus-0 sketch, which the fairing turns into pits and
 tears.
 
+Both close the surface flat on a side of the strokes' bounding box that it leaves
+through a drawn rim (``rims``, :mod:`neural.rims`): Eq. 5 continues a surface past an
+open rim, so a capped cylinder drawn by its rims and rulings became a tube through the
+box's walls, a portafilter's basket a dome.
+
 Both fit the separately drawn bodies of a connected drawing each on its own, two at
 once (``split_parts``, :mod:`neural.parts`): one field for the whole joins close bodies
 with a web that no stroke holds.
@@ -250,6 +255,12 @@ class FlowConfig:
         sized mesh off the surface's curvature (4 times the triangles a round). One round
         in ``draft`` and ``default``; none in ``paper`` (its 256^3 grid). Not with
         ``anchors``. Not in the paper.
+    rims : float
+        Where the zero set leaves the strokes' bounding box through a drawn rim (at
+        least this share of its crossing of a side's plane within
+        :data:`neural.rims.RIM_REACH` cells of a stroke), it is closed flat on that
+        plane instead of running on past the rim (:func:`neural.rims.close_rims`); 0 =
+        never. 0.5 in ``draft`` and ``default``. Not with ``anchors``. Not in the paper.
     split_parts : int
         1: the route fits the separately drawn parts of a connected drawing one at a
         time (:func:`neural.parts.fit_parts`; the paper does so by hand for one
@@ -298,6 +309,7 @@ class FlowConfig:
     attach_normals: float = 0.0
     handles: int = 0
     subdivide: int = 0
+    rims: float = 0.0
     split_parts: int = 0
 
     def as_dict(self) -> dict:
@@ -309,11 +321,11 @@ PRESETS: dict[str, FlowConfig] = {
     "draft": FlowConfig(res=64, width=64, hidden_layers=2, n_stroke=1200, n_surface=1000,
                         n_volume=600, init_steps=40, steps=100, lr=3e-4, poisson_every=1,
                         w_smooth=0.1, attach=10.0, attach_band=0.005, subdivide=1,
-                        split_parts=1),
+                        rims=0.5, split_parts=1),
     "default": FlowConfig(init_res=64, bridge_steps=30, steps=140, w_smooth=0.1, polish=4,
                           polish_rounds=4, polish_strip=1.0, average_from=0.6, attach=20.0,
                           attach_band=0.005, attach_reach=6.0, attach_normals=40.0,
-                          handles=5, subdivide=1, split_parts=1),
+                          handles=5, subdivide=1, rims=0.5, split_parts=1),
     "paper": FlowConfig(res=256, width=256, hidden_layers=4, n_stroke=10000, n_surface=15000,
                         n_volume=15000, init_steps=200, steps=800, lr=5e-5,
                         geometric_init_steps=0),

@@ -122,12 +122,19 @@ def point_surface_distance(points, vertices, faces, *, closest: bool = False) ->
     closest_points : (n, 3) float64
         Only with ``closest=True``: the closest point of the surface to each point.
 
+    Raises
+    ------
+    InvalidParameterError
+        The mesh has no triangle (libigl's tree would crash on it).
+
     Notes
     -----
     Uses libigl's AABB tree (``igl.point_mesh_squared_distance``), O((n + F) log F).
     """
     import igl
 
+    if len(faces) == 0:
+        raise InvalidParameterError("distance to a mesh with no triangle")
     sq, idx, near = igl.point_mesh_squared_distance(
         np.ascontiguousarray(points, dtype=np.float64),
         np.ascontiguousarray(vertices, dtype=np.float64),
