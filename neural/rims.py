@@ -93,7 +93,6 @@ def close_rims(f: np.ndarray, origin: np.ndarray, h: float, box, strokes,
     if share <= 0 or box is None or not len(strokes):
         return f, lo, hi
     n = f.shape[0]
-    step = _step(f)
     tree = cKDTree(densify_polylines(strokes, 0.5 * h)[0])
     clip = None
     for axis in range(3):
@@ -113,7 +112,7 @@ def close_rims(f: np.ndarray, origin: np.ndarray, h: float, box, strokes,
     if clip is None:
         return f, lo, hi
     # saturated at the box corner's value, so f away from the surface keeps its scale
-    return np.maximum(f, np.minimum(step * clip, f[0, 0, 0]).astype(np.float32)), lo, hi
+    return np.maximum(f, np.minimum(_step(f) * clip, f[0, 0, 0]).astype(np.float32)), lo, hi
 
 
 def clamp_to(V: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
