@@ -589,7 +589,8 @@ def surface(source, *, method: str = "auto", patchset: PatchSet | None = None,
     diag["fidelity"] = sketch_fidelity(mesh, ref, wires=wires)
     timings["fidelity"] = time.perf_counter() - t
     diag["topology"] = surface_topology(mesh.vertices, mesh.faces)
-    if diag.get("neural", {}).get("open_at_box"):    # the field left the padded box
-        diag["topology"]["open_at_box"] = int(diag["neural"]["open_at_box"])
+    for key in ("open_at_box", "rims_closed"):    # the field left the box, was closed
+        if diag.get("neural", {}).get(key):
+            diag["topology"][key] = int(diag["neural"][key])
     return SurfaceResult(mesh, name, sketch, net, ps, timings, diag, decision, wires,
                          face_route, routes, control_net=getattr(res, "control_net", None))

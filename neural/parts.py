@@ -177,7 +177,8 @@ def fit_parts(strokes, labels=None, *, quality: str = "draft", **kwargs):
         largest part's, with ``split`` the list of every part's ``strokes`` (indices
         into the strokes that are not ``construction`` strokes),
         ``settings`` (its ``res`` and sample counts) and ``report``, and the totals
-        ``n_vertices``, ``n_faces`` and ``interrupted``.
+        ``n_vertices``, ``n_faces``, ``open_at_box``, ``rims_closed`` and
+        ``interrupted``.
     """
     from curvenet.core.result import MeshResult
 
@@ -210,6 +211,7 @@ def fit_parts(strokes, labels=None, *, quality: str = "draft", **kwargs):
     report = {**split[0]["report"], "split": split, "n_vertices": offset,
               "n_faces": sum(len(f) for f in Fs),
               "open_at_box": sum(s["report"].get("open_at_box", 0) for s in split),
+              "rims_closed": sum(s["report"].get("rims_closed", 0) for s in split),
               "interrupted": len(split) < len(parts)
               or any(s["report"]["interrupted"] for s in split)}
     return MeshResult(np.vstack(Vs), np.vstack(Fs), report)

@@ -81,7 +81,9 @@ def surface_topology(vertices, faces) -> dict:
 
 def format_topology(topology: dict) -> str:
     """One line for :func:`surface_topology`'s dict (with ``open_at_box``, the neural
-    route's :func:`neural.extract.edges_at_walls` count, when it is not 0).
+    route's :func:`neural.extract.edges_at_walls` count, and ``rims_closed``, the sides of
+    the strokes' box it closed flat at a rim, :func:`neural.rims.close_rims`, when they
+    are not 0).
 
     Examples
     --------
@@ -91,6 +93,9 @@ def format_topology(topology: dict) -> str:
     >>> format_topology({"pieces": 2, "closed": 1, "boundary_loops": 3,
     ...                  "nonmanifold_edges": 0, "euler": 1, "genus": 0})
     'surface: 2 pieces, 1 closed (genus 0), 3 boundary loops, Euler characteristic 1'
+    >>> format_topology({"pieces": 1, "closed": 1, "boundary_loops": 0,
+    ...                  "nonmanifold_edges": 0, "euler": 2, "genus": 0, "rims_closed": 2})
+    "surface: 1 piece, closed, genus 0, flat at 2 rims on the strokes' bounding box"
     """
     k, closed = topology["pieces"], topology["closed"]
     text = f"surface: {k} piece{'s' if k != 1 else ''}"
@@ -102,6 +107,9 @@ def format_topology(topology: dict) -> str:
         loops = topology["boundary_loops"]
         text += (f", {loops} boundary loop{'s' if loops != 1 else ''}, Euler characteristic "
                  f"{topology['euler']}")
+    rims = topology.get("rims_closed", 0)
+    if rims:
+        text += f", flat at {rims} rim{'s' if rims != 1 else ''} on the strokes' bounding box"
     if topology.get("open_at_box"):
         text += (" (open where the neural field's zero set reaches its padded box; "
                  "--closed-box keeps the surface inside)")
