@@ -273,8 +273,8 @@ def fit_flow_surface(strokes, *, labels=None, quality: str = "draft", device="cp
     strokes, labels = fit_strokes(strokes, labels)
     dev = torch_device(device)
     if box is None:
-        points = np.vstack(strokes)
-        box = (points.min(axis=0), points.max(axis=0))
+        from .rims import strokes_box
+        box = strokes_box(strokes)
     box = tuple(np.asarray(c, np.float64).reshape(3) for c in box)
     return _fit(strokes, labels, cfg, dev, int(seed), init_mesh, progress, cut_boundary, quality,
                 anchors=_check_anchors(anchors), desc=desc, stop=stop, box=box)

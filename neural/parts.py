@@ -184,6 +184,7 @@ def fit_parts(strokes, labels=None, *, quality: str = "draft", **kwargs):
 
     from .flow import fit_flow_surface, fit_strokes
     from .presets import FlowConfig, get_config
+    from .rims import strokes_box
     names = {f.name for f in fields(FlowConfig)}
     cfg = get_config(quality, **{k: v for k, v in kwargs.items() if k in names})
     whole = (not cfg.split_parts or kwargs.get("init_mesh") is not None
@@ -194,11 +195,11 @@ def fit_parts(strokes, labels=None, *, quality: str = "draft", **kwargs):
     if whole or len(parts) == 1:
         return fit_flow_surface(strokes, labels=labels, quality=quality, **kwargs)
     length = np.array([arc_length(s) for s in strokes])
-    extent = np.ptp(np.vstack(strokes), axis=0).max()
+    box = strokes_box(strokes)      # a rim closes on the whole sketch's box, not a part's
+    extent = (box[1] - box[0]).max()
     settings = [_part_settings(cfg, [strokes[i] for i in part], extent,
                                length[part].sum() / length.sum()) for part in parts]
-    points = np.vstack(strokes)     # a rim closes on the whole sketch's box, not a part's
-    kwargs = {"box": (points.min(axis=0), points.max(axis=0)), **kwargs}
+    kwargs = {"box": box, **kwargs}
     results = _fit_side_by_side(parts, settings, strokes, labels, quality, kwargs)
     Vs, Fs, split, offset = [], [], [], 0
     for part, setting, res in zip(parts, settings, results):

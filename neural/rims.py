@@ -40,12 +40,19 @@ from scipy.spatial import cKDTree
 
 from curvenet.core.geometry import densify_polylines
 
-__all__ = ["RIM_REACH", "close_rims", "clamp_to"]
+__all__ = ["RIM_REACH", "close_rims", "clamp_to", "strokes_box"]
 
 #: A crossing point of a side's plane lies on a rim when a stroke is within this many
 #: grid cells of it (the fairing's reach at ``default``, ``FlowConfig.attach_reach``,
 #: is 6; the zero set lies within a cell or two of smooth strokes).
 RIM_REACH = 3.0
+
+
+def strokes_box(strokes) -> tuple[np.ndarray, np.ndarray]:
+    """Lowest and highest corner, (3,) float64 each, of the points of ``strokes`` (list of
+    (k_i, 3) float64): the box whose sides :func:`close_rims` looks at."""
+    points = np.vstack(strokes)
+    return points.min(axis=0), points.max(axis=0)
 
 
 def close_rims(f: np.ndarray, origin: np.ndarray, h: float, box, strokes,

@@ -12,7 +12,7 @@ from curvenet.evaluate.topology import format_topology
 from curvenet.model import Sketch
 from curvenet.neural.extract import marching_cubes_world
 from curvenet.neural.parts import fit_parts
-from curvenet.neural.rims import clamp_to, close_rims
+from curvenet.neural.rims import clamp_to, close_rims, strokes_box
 
 from ._metrics import fscore
 
@@ -23,15 +23,10 @@ X, Y, Z = np.meshgrid(AXIS, AXIS, AXIS, indexing="ij")
 T = np.linspace(0.0, 2.0 * np.pi, 200)
 
 
-def _box(strokes):
-    p = np.vstack(strokes)
-    return p.min(axis=0), p.max(axis=0)
-
-
 def test_an_endless_tube_closes_flat_at_its_two_rims_and_nowhere_else():
     tube = (np.hypot(X, Y) - 0.6).astype(np.float32)
     rims = [np.c_[0.6 * np.cos(T), 0.6 * np.sin(T), np.full_like(T, z)] for z in (-0.7, 0.5)]
-    f, lo, hi = close_rims(tube, ORIGIN, H, _box(rims), rims, 0.5)
+    f, lo, hi = close_rims(tube, ORIGIN, H, strokes_box(rims), rims, 0.5)
     assert lo.tolist() == [-np.inf, -np.inf, -0.7] and hi.tolist() == [np.inf, np.inf, 0.5]
     V, F = marching_cubes_world(f, ORIGIN, H)
     mesh = trimesh.Trimesh(V, F)
@@ -49,7 +44,7 @@ def test_a_sphere_whose_strokes_miss_its_poles_is_not_clipped():
     # that no stroke follows
     R = Rotation.from_euler("xyz", [45, 20, 45], degrees=True).as_matrix()
     strokes = [e.curve @ R.T for e in great_circles(3).network.edges]
-    lo_s, hi_s = _box(strokes)
+    lo_s, hi_s = strokes_box(strokes)
     assert (hi_s < 0.95).all() and (lo_s > -0.95).all()
     sphere = (np.sqrt(X ** 2 + Y ** 2 + Z ** 2) - 1.0).astype(np.float32)
     f, lo, hi = close_rims(sphere, ORIGIN, H, (lo_s, hi_s), strokes, 0.5)
@@ -61,14 +56,14 @@ def test_a_flat_sketch_keeps_its_surface():
     # the sphere crosses along the circle itself) would leave no surface
     equator = [np.c_[np.cos(T), np.sin(T), np.zeros_like(T)]]
     sphere = (np.sqrt(X ** 2 + Y ** 2 + Z ** 2) - 1.0).astype(np.float32)
-    f, lo, hi = close_rims(sphere, ORIGIN, H, _box(equator), equator, 0.5)
+    f, lo, hi = close_rims(sphere, ORIGIN, H, strokes_box(equator), equator, 0.5)
     assert f is sphere and np.isinf(lo).all() and np.isinf(hi).all()
 
 
 def test_share_zero_closes_nothing():
     tube = (np.hypot(X, Y) - 0.6).astype(np.float32)
     rims = [np.c_[0.6 * np.cos(T), 0.6 * np.sin(T), np.full_like(T, z)] for z in (-0.7, 0.5)]
-    f, lo, hi = close_rims(tube, ORIGIN, H, _box(rims), rims, 0.0)
+    f, lo, hi = close_rims(tube, ORIGIN, H, strokes_box(rims), rims, 0.0)
     assert f is tube and np.isinf(lo).all() and np.isinf(hi).all()
 
 
